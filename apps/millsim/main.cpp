@@ -1,0 +1,223 @@
+// millsim: the command-line program. `millsim --help` lists the commands.
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "millsim/builtin_example.hpp"
+#include "millsim/core/error.hpp"
+#include "millsim/io/config.hpp"
+#include "millsim/io/output.hpp"
+#include "millsim/sim/mill_run.hpp"
+
+namespace {
+
+using millsim::MillConfig;
+using millsim::MillPlan;
+using millsim::MillResult;
+
+struct JobOptions {
+  std::string config_path;  // empty: the built-in example
+  std::vector<std::string> overrides;
+  std::string output_directory;  // empty: from the config
+  bool quiet = false;
+};
+
+MillConfig load(const JobOptions& options) {
+  std::vector<std::string> overrides = options.overrides;
+  if (!options.output_directory.empty()) {
+    overrides.push_back(fmt::format("output.directory={}", options.output_directory));
+  }
+  if (options.config_path.empty()) {
+    return millsim::parse_mill_config(millsim::builtin_example_toml,
+                                      std::string(millsim::builtin_example_name), overrides);
+  }
+  return millsim::load_mill_config(options.config_path, overrides);
+}
+
+/// A single progress line on stderr, redrawn in place; only when stderr is a terminal.
+class ProgressLine {
+ public:
+  explicit ProgressLine(bool enabled) : enabled_(enabled && isatty(fileno(stderr)) != 0) {}
+  ~ProgressLine() { clear(); }
+  ProgressLine(const ProgressLine&) = delete;
+  ProgressLine& operator=(const ProgressLine&) = delete;
+
+  void operator()(double time, double total, double revolutions) {
+    if (!enabled_) return;
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double fraction = std::min(1.0, time / total);
+    const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
+    fmt::print(stderr, "\r{:5.1f}%  t = {:.2f} of {:.2f} s  revolutions {:.2f}  ETA {:.0f} s   ",
+               100.0 * fraction, time, total, revolutions, eta);
+    std::fflush(stderr);
+    drawn_ = true;
+  }
+  void clear() {
+    if (drawn_) fmt::print(stderr, "\r{:80}\r", "");
+    drawn_ = false;
+  }
+
+ private:
+  bool enabled_;
+  bool drawn_ = false;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+/// Plans, places the charge, and only then creates the output directory and runs, so that a
+/// config that cannot run writes nothing.
+MillResult run_job(const MillConfig& config, bool show_progress) {
+  const MillPlan plan = millsim::plan_mill(config);
+  millsim::World<2> world = millsim::build_mill_world(plan);
+  const std::filesystem::path out = config.output_directory;
+  std::filesystem::create_directories(out);
+  const std::filesystem::path snapshots = out / "snapshots";
+  std::filesystem::remove_all(snapshots);
+  if (config.snapshot_interval > 0.0) std::filesystem::create_directories(snapshots);
+  std::filesystem::remove(out / "summary.json");
+  ProgressLine progress(show_progress);
+  MillResult result = millsim::run_mill(plan, std::move(world), snapshots, std::ref(progress));
+  progress.clear();
+  millsim::write_results(out, result);
+  return result;
+}
+
+int run_command(const JobOptions& options) {
+  const MillConfig config = load(options);
+  if (!options.quiet) fmt::print("millsim: running {}\n", config.source);
+  const MillResult result = run_job(config, !options.quiet);
+  fmt::print("{}\n", millsim::summary_line(result));
+  if (!options.quiet) {
+    fmt::print("results in {}/ (summary.json, power.csv, power_timeseries.csv, spectrum.csv)\n",
+               config.output_directory);
+  }
+  return 0;
+}
+
+int info_command(const JobOptions& options) {
+  const MillPlan plan = millsim::plan_mill(load(options));
+  const MillConfig& c = plan.config;
+  fmt::print("config                {}\n", c.source);
+  fmt::print("mill                  {} m x {} m, {} lifters {} x {} m (height x width)\n",
+             c.diameter, c.length, c.lifter_count, c.lifter_height, c.lifter_width);
+  fmt::print("critical speed        {:.4g} rpm (largest ball {} m)\n", plan.critical_speed_rpm,
+             plan.largest_ball);
+  fmt::print("speed                 {:.4g} rpm = {:.1f}% of critical, {:.4g} s per revolution\n",
+             plan.speed_rpm, 100.0 * plan.speed_fraction, plan.revolution_period);
+  fmt::print("charge                filling {}, porosity {}, density {} kg/m3; {}\n", c.filling,
+             c.porosity, c.density, c.size_description);
+  for (const auto& d : plan.discs) {
+    fmt::print("  discs               {:5d} x {:.4g} m, {:.4g} kg each\n", d.count, d.diameter,
+               d.mass);
+  }
+  fmt::print("particles             {}\n", plan.particle_count);
+  fmt::print("slice charge mass     {:.4g} kg; whole mill {:.4g} kg; power scale {:.4g}\n",
+             plan.slice_mass, plan.mill_charge_mass, plan.power_scale);
+  fmt::print("contact duration      ball-ball {:.4g} s, ball-wall {:.4g} s (smallest balls)\n",
+             plan.contact_duration_ball_ball, plan.contact_duration_ball_wall);
+  fmt::print("time step             {:.4g} s{} (stability limit {:.4g} s)\n", plan.time_step,
+             c.time_step ? "" : " (auto)", plan.critical_time_step);
+  const double steps = plan.total_time / plan.time_step;
+  fmt::print("simulated time        {:.4g} s: settle {} s + {} revolutions; {:.3g} steps\n",
+             plan.total_time, c.settle_time, c.revolutions, steps);
+  return 0;
+}
+
+int validate_command(const std::string& directory, const JobOptions& options) {
+  std::vector<std::filesystem::path> cases;
+  if (!std::filesystem::is_directory(directory)) {
+    throw millsim::InputError(fmt::format("{}: not a directory of validation configs", directory));
+  }
+  for (const auto& entry : std::filesystem::directory_iterator(directory)) {
+    if (entry.path().extension() == ".toml") cases.push_back(entry.path());
+  }
+  std::sort(cases.begin(), cases.end());
+  const std::string root =
+      options.output_directory.empty() ? "runs/validation" : options.output_directory;
+  struct Row {
+    std::string name;
+    double measured, paper, predicted, tolerance;
+  };
+  std::vector<Row> rows;
+  for (const auto& path : cases) {
+    std::vector<std::string> overrides = options.overrides;
+    overrides.push_back(fmt::format("output.directory={}/{}", root, path.stem().string()));
+    const MillConfig config = millsim::load_mill_config(path.string(), overrides);
+    if (!config.reference) {
+      throw millsim::InputError(
+          fmt::format("{}: a validation config needs a [reference] table", path.string()));
+    }
+    fmt::print(stderr, "running {} ...\n", path.string());
+    const MillResult result = run_job(config, !options.quiet);
+    rows.push_back({config.reference->case_name, config.reference->measured_kw,
+                    config.reference->paper_kw.value_or(0.0), result.power_kw,
+                    config.reference->tolerance});
+  }
+  fmt::print("{:<8} {:>12} {:>12} {:>12} {:>9} {:>10}  {}\n", "case", "measured_kW", "paper_kW",
+             "millsim_kW", "error_%", "paper_err%", "within");
+  int failures = 0;
+  for (const Row& r : rows) {
+    const double error = (r.predicted - r.measured) / r.measured;
+    const bool ok = std::abs(error) <= r.tolerance;
+    failures += ok ? 0 : 1;
+    fmt::print("{:<8} {:>12.4g} {:>12.4g} {:>12.4g} {:>+9.1f} {:>+10.1f}  {} (±{:.0f}%)\n", r.name,
+               r.measured, r.paper, r.predicted, 100.0 * error,
+               100.0 * (r.paper - r.measured) / r.measured, ok ? "yes" : "NO", 100.0 * r.tolerance);
+  }
+  return failures == 0 ? 0 : 1;
+}
+
+void add_job_options(CLI::App& command, JobOptions& options) {
+  command.add_option("--set", options.overrides,
+                     "override a config key, e.g. --set mill.speed=0.75 (repeatable)");
+  command.add_flag("-q,--quiet", options.quiet, "print only the one-line summary");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"millsim: discrete element simulation of tumbling mills"};
+  app.require_subcommand(1);
+  JobOptions options;
+  std::string validation_directory = "examples/validation";
+
+  CLI::App* run = app.add_subcommand("run", "simulate a mill and report its power draft");
+  run->add_option("config", options.config_path,
+                  "mill config (TOML); default: the built-in example");
+  run->add_option("-o,--out", options.output_directory,
+                  "output directory (overrides output.directory)");
+  add_job_options(*run, options);
+
+  CLI::App* info = app.add_subcommand("info", "print derived quantities of a mill, no simulation");
+  info->add_option("config", options.config_path,
+                   "mill config (TOML); default: the built-in example");
+  info->add_option("--set", options.overrides, "override a config key (repeatable)");
+
+  CLI::App* validate = app.add_subcommand(
+      "validate", "run every measured-mill case in a directory and compare with measurements");
+  validate->add_option("directory", validation_directory, "directory of validation configs")
+      ->capture_default_str();
+  validate->add_option("-o,--out", options.output_directory,
+                       "where the runs go (default runs/validation)");
+  add_job_options(*validate, options);
+
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (run->parsed()) return run_command(options);
+    if (info->parsed()) return info_command(options);
+    return validate_command(validation_directory, options);
+  } catch (const millsim::InputError& error) {
+    fmt::print(stderr, "millsim: error: {}\n", error.what());
+    return 2;
+  } catch (const std::exception& error) {
+    fmt::print(stderr, "millsim: failed: {}\n", error.what());
+    return 1;
+  }
+}

@@ -1,0 +1,39 @@
+// What every contact law sees and returns, and the history a contact carries between steps.
+#pragma once
+
+#include "millsim/core/vec.hpp"
+
+namespace millsim {
+
+/// Remembered from step to step while two bodies overlap (MODEL.md §3).
+template <int D>
+struct ContactHistory {
+  /// Overlap at which the normal spring was last (re)started: F_n,spring = k_n (δ − origin).
+  /// This is the incremental normal spring F_n ← F_n − k_n (v·n) Δt integrated exactly.
+  double normal_spring_origin = 0.0;
+  Vec<D> tangential_spring{};  ///< F_s, kept perpendicular to the current normal
+  double dissipated = 0.0;     ///< energy dissipated since the bodies first touched, J
+  double overlap = 0.0;        ///< δ at the last evaluation, m (for the stored-energy account)
+  bool touching = false;       ///< the bodies overlap (the collision is under way)
+};
+
+/// Geometry and relative motion of one contact, body B relative to body A.
+template <int D>
+struct ContactInput {
+  Vec<D> normal{};       ///< unit vector from A towards B (from a wall into the particle)
+  double overlap = 0.0;  ///< δ > 0, m
+  Vec<D> velocity{};     ///< u̇_B − u̇_A at the contact point from translation alone
+  Vec<D> spin_velocity{};  ///< n × (r_A ω_A + r_B ω_B): the rotational part of the sliding velocity
+  double effective_mass = 0.0;  ///< m* = m_A m_B / (m_A + m_B); m of the particle for a wall
+};
+
+/// What a law returns: the force on B (A gets the opposite), its tangential part (the one that
+/// makes torques) and the energy it dissipated during this step.
+template <int D>
+struct ContactOutput {
+  Vec<D> force{};
+  Vec<D> tangential_force{};
+  double dissipated = 0.0;  ///< J, this step
+};
+
+}  // namespace millsim

@@ -1,0 +1,105 @@
+// The linear spring–dashpot contact law with Coulomb friction of MODEL.md §3.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "millsim/contact/contact.hpp"
+#include "millsim/particles/material.hpp"
+
+namespace millsim {
+
+/// Stateless: its members are parameters, all state lives in the ContactHistory it is given.
+/// Particle–particle and particle–wall contacts use this same law; only the inputs differ.
+class LinearSpringDashpot {
+ public:
+  /// allow_tension = false is the model of MODEL.md (the total normal force never pulls; the
+  /// contact forgets its springs when it would). true lets the dashpot pull at the end of an
+  /// impact, the case for which Corkum's relation is exact; tests use it to check that relation.
+  explicit LinearSpringDashpot(const ContactMaterial& material, bool allow_tension = false)
+      : normal_stiffness_(material.normal_stiffness),
+        tangential_stiffness_(material.tangential_stiffness),
+        damping_ratio_(damping_ratio(material.restitution)),
+        friction_(material.friction),
+        allow_tension_(allow_tension) {}
+
+  double normal_stiffness() const { return normal_stiffness_; }
+  double tangential_stiffness() const { return tangential_stiffness_; }
+
+  /// Energy held by the springs of a contact, J: F_n²/(2 k_n) + |F_s|²/(2 k_s).
+  template <int D>
+  double stored_energy(const ContactHistory<D>& history, double overlap) const {
+    const double spring =
+        std::max(0.0, normal_stiffness_ * (overlap - history.normal_spring_origin));
+    return spring * spring / (2.0 * normal_stiffness_) +
+           norm_squared(history.tangential_spring) / (2.0 * tangential_stiffness_);
+  }
+
+  template <int D>
+  ContactOutput<D> evaluate(const ContactInput<D>& in, ContactHistory<D>& history,
+                            double time_step) const {
+    const Vec<D>& n = in.normal;
+    const double normal_speed = dot(in.velocity, n);  // v·n < 0 while the pair approaches
+    const Vec<D> sliding_velocity = in.velocity - normal_speed * n + in.spin_velocity;  // v_s
+
+    // Normal: spring k_n (δ − origin) and dashpot D_n = −c_n v_n, c_n = 2 ζ sqrt(k_n m*).
+    const double sqrt_mass = std::sqrt(in.effective_mass);
+    const double normal_damping = 2.0 * damping_ratio_ * std::sqrt(normal_stiffness_) * sqrt_mass;
+    const double normal_spring = normal_stiffness_ * (in.overlap - history.normal_spring_origin);
+    const double normal_force = normal_spring - normal_damping * normal_speed;
+
+    // R(F_s): turn the stored tangential spring into the current tangent plane, keeping its
+    // length (in 2D this is the exact rotation; in 3D a first-order one).
+    Vec<D> spring = history.tangential_spring;
+    const double spring_length_squared = norm_squared(spring);
+    if (spring_length_squared > 0.0) {
+      spring -= dot(spring, n) * n;
+      const double projected = norm_squared(spring);
+      spring *= projected > 0.0 ? std::sqrt(spring_length_squared / projected) : 0.0;
+    }
+
+    ContactOutput<D> out;
+    if (normal_force <= 0.0 && !allow_tension_) {
+      // No tension: the contact breaks and forgets its springs; what they held is lost.
+      const double held = std::max(0.0, normal_spring);
+      out.dissipated = held * held / (2.0 * normal_stiffness_) +
+                       norm_squared(spring) / (2.0 * tangential_stiffness_);
+      history.normal_spring_origin = in.overlap;
+      history.tangential_spring = Vec<D>{};
+      history.dissipated += out.dissipated;
+      return out;
+    }
+    out.dissipated = normal_damping * normal_speed * normal_speed * time_step;  // |D_n·v_n| Δt
+
+    // Tangential spring F_s ← R(F_s) − k_s v_s Δt, dashpot D_s = −c_s v_s, Coulomb cap μ F_N
+    // on the total normal force F_N (so that the friction impulse is μ times the normal one).
+    spring -= (tangential_stiffness_ * time_step) * sliding_velocity;
+    const double friction_limit = friction_ * std::abs(normal_force);
+    const double spring_length = norm(spring);
+    if (spring_length > friction_limit) {
+      // Slipping: cap the spring, drop the dashpot. The friction work is the cap times the slip
+      // the spring could not take up: μ F_N (|F_s,trial| − μ F_N) / k_s.
+      out.dissipated += friction_limit * (spring_length - friction_limit) / tangential_stiffness_;
+      spring *= friction_limit / spring_length;
+      out.tangential_force = spring;
+    } else {
+      const double tangential_damping =
+          2.0 * damping_ratio_ * std::sqrt(tangential_stiffness_) * sqrt_mass;
+      out.tangential_force = spring - tangential_damping * sliding_velocity;
+      out.dissipated += tangential_damping * norm_squared(sliding_velocity) * time_step;
+    }
+    history.tangential_spring = spring;
+    history.dissipated += out.dissipated;
+    out.force = normal_force * n + out.tangential_force;
+    return out;
+  }
+
+ private:
+  double normal_stiffness_;
+  double tangential_stiffness_;
+  double damping_ratio_;
+  double friction_;
+  bool allow_tension_;
+};
+
+}  // namespace millsim

@@ -1,0 +1,76 @@
+// The mill description a user writes (README "Config reference"), read from TOML.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "millsim/particles/material.hpp"
+
+namespace millsim {
+
+struct SizeClass {
+  double diameter = 0.0;       ///< m
+  double mass_fraction = 0.0;  ///< of the charge mass, sums to 1 over the classes
+};
+
+/// Measured and published power of a validation case ([reference] table), for `validate`.
+struct ReferencePower {
+  std::string case_name;
+  double measured_kw = 0.0;
+  std::optional<double> paper_kw;
+  double tolerance = 0.15;  ///< allowed relative error against measured
+};
+
+struct MillConfig {
+  std::string source;  ///< the file it came from, for messages
+
+  // [simulation]
+  int dimension = 2;
+  std::optional<double> time_step;  ///< s; empty = "auto"
+  double settle_time = 1.0;         ///< s
+  double revolutions = 6.0;
+  int measure_revolutions = 4;
+  std::uint64_t seed = 1;
+
+  // [mill]
+  double diameter = 0.0;                 ///< m, inside the shell
+  double length = 0.0;                   ///< m
+  std::optional<double> speed_fraction;  ///< of critical speed
+  std::optional<double> speed_rpm;
+  int lifter_count = 0;
+  double lifter_height = 0.0;  ///< m, radial
+  double lifter_width = 0.0;   ///< m, tangential
+
+  // [charge]
+  double filling = 0.0;
+  double porosity = 0.4;
+  double density = 7800.0;  ///< kg/m³
+  std::vector<SizeClass> sizes;
+  std::string size_description;  ///< how the sizes were given, for reports
+
+  // [materials]
+  ContactMaterial ball_ball;
+  ContactMaterial ball_wall;
+
+  // [output]
+  std::string output_directory = "out";
+  double snapshot_interval = 0.05;  ///< s; 0 = none
+
+  std::optional<ReferencePower> reference;
+};
+
+/// Reads a mill config from TOML text. `source` names it in messages. Throws InputError.
+MillConfig parse_mill_config(std::string_view toml_text, const std::string& source,
+                             const std::vector<std::string>& overrides = {});
+/// Reads a mill config file. Throws InputError (also for a missing or unreadable file).
+MillConfig load_mill_config(const std::string& path,
+                            const std::vector<std::string>& overrides = {});
+
+/// The graded charge millsim uses for `top_size` (docs/model.md): Bond's equilibrium ball
+/// charge, cumulative mass passing d = (d / top)^3.84, in four classes of ratio 0.8.
+std::vector<SizeClass> graded_charge(double top_size);
+
+}  // namespace millsim

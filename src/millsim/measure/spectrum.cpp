@@ -1,0 +1,58 @@
+#include "millsim/measure/spectrum.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace millsim {
+
+std::string_view contact_type_name(ContactType type) {
+  switch (type) {
+    case ContactType::ball_ball:
+      return "ball_ball";
+    case ContactType::ball_shell:
+      return "ball_shell";
+    case ContactType::ball_lifter:
+      return "ball_lifter";
+    case ContactType::ball_plane:
+      return "ball_plane";
+  }
+  return "unknown";
+}
+
+ImpactSpectrum::ImpactSpectrum(double lowest_energy, int bins_per_decade, int decades)
+    : lowest_energy_(lowest_energy), bins_per_decade_(bins_per_decade) {
+  const auto bins = static_cast<std::size_t>(bins_per_decade * decades);
+  for (auto& c : counts_) c.assign(bins, 0);
+  for (auto& e : energies_) e.assign(bins, 0.0);
+}
+
+void ImpactSpectrum::record(ContactType type, double energy) {
+  const double position = std::log10(std::max(energy, lowest_energy_) / lowest_energy_);
+  const auto last = static_cast<long>(bin_count()) - 1;
+  const long bin = std::clamp(static_cast<long>(position * bins_per_decade_), 0L, last);
+  const auto t = static_cast<std::size_t>(type);
+  ++counts_[t][static_cast<std::size_t>(bin)];
+  energies_[t][static_cast<std::size_t>(bin)] += energy;
+}
+
+double ImpactSpectrum::bin_lower_edge(std::size_t bin) const {
+  if (bin == 0) return 0.0;
+  return lowest_energy_ * std::pow(10.0, static_cast<double>(bin) / bins_per_decade_);
+}
+
+double ImpactSpectrum::bin_upper_edge(std::size_t bin) const {
+  return lowest_energy_ * std::pow(10.0, static_cast<double>(bin + 1) / bins_per_decade_);
+}
+
+long ImpactSpectrum::total_count(ContactType type) const {
+  const auto& c = counts_[static_cast<std::size_t>(type)];
+  return std::accumulate(c.begin(), c.end(), 0L);
+}
+
+double ImpactSpectrum::total_energy(ContactType type) const {
+  const auto& e = energies_[static_cast<std::size_t>(type)];
+  return std::accumulate(e.begin(), e.end(), 0.0);
+}
+
+}  // namespace millsim

@@ -1,0 +1,50 @@
+// Contact search (MODEL.md §5): a cell grid finds the pairs closer than the sum of their radii
+// plus a skin; the list is kept until some particle has moved half a skin, and the history of
+// every pair (its springs, its dissipated energy) is carried over when the list is rebuilt.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "millsim/contact/contact.hpp"
+#include "millsim/core/vec.hpp"
+
+namespace millsim {
+
+template <int D>
+class NeighbourList {
+ public:
+  /// skin: extra distance beyond contact within which pairs are listed, m (> 0).
+  explicit NeighbourList(double skin) : skin_(skin) {}
+
+  /// True when a particle has moved more than half the skin since the last rebuild (or the
+  /// particle count changed): only then can a pair not in the list have come into contact.
+  bool needs_refresh(const std::vector<Vec<D>>& position) const;
+
+  /// Rebuilds the pair list, sorted by (first, second), carrying each kept pair's history.
+  void rebuild(const std::vector<Vec<D>>& position, const std::vector<double>& radius);
+
+  std::size_t pair_count() const { return first_.size(); }
+  const std::vector<std::uint32_t>& first() const { return first_; }
+  const std::vector<std::uint32_t>& second() const { return second_; }
+  std::vector<ContactHistory<D>>& history() { return history_; }
+  const std::vector<ContactHistory<D>>& history() const { return history_; }
+  long rebuild_count() const { return rebuild_count_; }
+  double skin() const { return skin_; }
+
+ private:
+  double skin_;
+  long rebuild_count_ = 0;
+  std::vector<std::uint32_t> first_, second_;
+  std::vector<ContactHistory<D>> history_;
+  std::vector<Vec<D>> reference_position_;
+  // Scratch kept between rebuilds so that a rebuild allocates nothing in steady state.
+  std::vector<std::uint32_t> particle_cell_, cell_start_, cell_cursor_, cell_members_;
+  std::vector<std::uint32_t> next_first_, next_second_;
+  std::vector<ContactHistory<D>> next_history_;
+};
+
+extern template class NeighbourList<2>;
+extern template class NeighbourList<3>;
+
+}  // namespace millsim

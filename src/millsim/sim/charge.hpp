@@ -1,0 +1,55 @@
+// From a mill config to everything derived from it (speeds, ball counts, masses, time step),
+// and the charge placed in the mill.
+#pragma once
+
+#include <vector>
+
+#include "millsim/io/config.hpp"
+#include "millsim/sim/world.hpp"
+
+namespace millsim {
+
+/// A settled 2D bed of frictional discs holds this fraction of its area in voids (random
+/// packings of discs: 0.16–0.22; docs/model.md). It sets how many discs fill J of a slice.
+inline constexpr double disc_bed_porosity = 0.2;
+/// Default steps per contact duration of the stiffest, lightest pair ("auto" time step).
+inline constexpr double steps_per_contact = 20.0;
+
+struct DiscClass {
+  double diameter = 0.0;  ///< m
+  double mass = 0.0;      ///< kg: the mass of the sphere of that diameter
+  int count = 0;
+};
+
+/// Derived quantities of a mill run (`millsim info` prints them).
+struct MillPlan {
+  MillConfig config;
+  double radius = 0.0;              ///< m
+  double largest_ball = 0.0;        ///< m
+  double critical_speed_rpm = 0.0;  ///< 42.3 / sqrt(D − d_max) (MODEL.md §1)
+  double speed_rpm = 0.0;
+  double speed_fraction = 0.0;
+  double angular_speed = 0.0;      ///< rad/s
+  double revolution_period = 0.0;  ///< s
+  std::vector<DiscClass> discs;
+  int particle_count = 0;
+  double slice_mass = 0.0;                  ///< kg, the simulated discs
+  double mill_charge_mass = 0.0;            ///< kg, ρ (1 − porosity) J π R² L
+  double power_scale = 0.0;                 ///< mill_charge_mass / slice_mass
+  double contact_duration_ball_ball = 0.0;  ///< s, smallest pair
+  double contact_duration_ball_wall = 0.0;  ///< s, smallest ball
+  double critical_time_step = 0.0;          ///< s, stability limit
+  double time_step = 0.0;                   ///< s, in use
+  double total_time = 0.0;                  ///< s, settling + rotation
+};
+
+/// Works out the plan; throws InputError when the config asks for the impossible (an unstable
+/// time step), naming the key.
+MillPlan plan_mill(const MillConfig& config);
+
+/// The World for a plan, with the shell still and the charge placed without overlaps at random
+/// (largest discs first) in the free space of the mill. Throws InputError when the discs do
+/// not fit.
+World<2> build_mill_world(const MillPlan& plan);
+
+}  // namespace millsim

@@ -1,0 +1,157 @@
+#include "millsim/sim/mill_run.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "millsim/core/constants.hpp"
+#include "millsim/io/output.hpp"
+
+namespace millsim {
+namespace {
+
+EnergySample sample(const World<2>& world) {
+  EnergySample s;
+  s.time = world.time();
+  s.shell_work = world.energy_account().shell_work;
+  s.dissipated = world.energy_account().dissipated;
+  s.kinetic = world.kinetic_energy();
+  s.potential = world.potential_energy();
+  s.stored = world.stored_spring_energy();
+  return s;
+}
+
+PowerInterval interval(const EnergySample& from, const EnergySample& to, double torque_time,
+                       double scale) {
+  PowerInterval p;
+  p.start_time = from.time;
+  p.end_time = to.time;
+  const double duration = to.time - from.time;
+  p.power = scale * (to.shell_work - from.shell_work) / duration;
+  p.dissipation_power = scale * (to.dissipated - from.dissipated) / duration;
+  p.torque = scale * torque_time / duration;
+  p.kinetic_energy = to.kinetic;
+  return p;
+}
+
+}  // namespace
+
+double spin_up_time(const MillPlan& plan) {
+  return 0.25 * plan.revolution_period;
+}
+
+MillResult run_mill(const MillPlan& plan, World<2> world,
+                    const std::filesystem::path& snapshot_directory,
+                    const ProgressCallback& progress) {
+  const auto started = std::chrono::steady_clock::now();
+  MillResult result;
+  result.plan = plan;
+  const double dt = plan.time_step;
+  const double settle = plan.config.settle_time;
+  const double ramp = spin_up_time(plan);
+  const double full_angle = 2.0 * pi * plan.config.revolutions;
+  const double measure_from =
+      2.0 * pi * (plan.config.revolutions - plan.config.measure_revolutions);
+  const double snapshot_interval = plan.config.snapshot_interval;
+  const double series_angle = 2.0 * pi / 50.0;
+
+  double next_snapshot = 0.0;
+  int snapshot_index = 0;
+  const auto write_snapshot_if_due = [&] {
+    if (snapshot_interval <= 0.0 || world.time() + 0.5 * dt < next_snapshot) return;
+    write_snapshot(snapshot_directory, snapshot_index++, world);
+    next_snapshot += snapshot_interval;
+  };
+
+  // Settle with the shell still.
+  while (world.time() + 0.5 * dt < settle) {
+    write_snapshot_if_due();
+    world.step();
+    if (progress && world.steps() % 2000 == 0) progress(world.time(), plan.total_time, 0.0);
+  }
+  result.settled_kinetic_energy = world.kinetic_energy();
+
+  // Turn: ω ramps up linearly over spin_up_time, then stays. Revolutions are counted by the
+  // angle the shell has turned.
+  Mill2D& mill = *world.walls().mill;
+  const double start_angle = mill.angle;
+  const double rotation_start = world.time();
+  EnergySample revolution_start = sample(world);
+  EnergySample series_start = revolution_start;
+  double revolution_torque_time = 0.0;
+  double series_torque_time = 0.0;
+  int next_revolution = 1;
+  bool measuring = false;
+  for (;;) {
+    const double turned = mill.angle - start_angle;
+    if (!measuring && turned >= measure_from - 1e-12) {
+      measuring = true;
+      result.window_start = sample(world);
+      world.record_collisions_in(&result.spectrum);
+    }
+    if (turned >= full_angle) break;
+    const double since = world.time() - rotation_start;
+    mill.angular_speed = plan.angular_speed * std::min(1.0, (since + 0.5 * dt) / ramp);
+    write_snapshot_if_due();
+    world.step();
+    revolution_torque_time += world.shell_torque() * dt;
+    series_torque_time += world.shell_torque() * dt;
+    const double now_turned = mill.angle - start_angle;
+    if (now_turned >= series_angle * static_cast<double>(result.series.size() + 1)) {
+      const EnergySample now = sample(world);
+      result.series.push_back(interval(series_start, now, series_torque_time, plan.power_scale));
+      series_start = now;
+      series_torque_time = 0.0;
+    }
+    if (now_turned >= 2.0 * pi * next_revolution) {
+      const EnergySample now = sample(world);
+      result.revolutions.push_back(
+          interval(revolution_start, now, revolution_torque_time, plan.power_scale));
+      revolution_start = now;
+      revolution_torque_time = 0.0;
+      ++next_revolution;
+    }
+    if (progress && world.steps() % 2000 == 0) {
+      progress(world.time(), plan.total_time, now_turned / (2.0 * pi));
+    }
+  }
+  world.record_collisions_in(nullptr);
+  result.window_end = sample(world);
+
+  // Means over the measured window, spread between its revolutions.
+  const EnergySample& a = result.window_start;
+  const EnergySample& b = result.window_end;
+  const double window = b.time - a.time;
+  const double work = b.shell_work - a.shell_work;
+  const double dissipated = b.dissipated - a.dissipated;
+  result.power_kw = plan.power_scale * work / window / 1000.0;
+  result.power_dissipation_kw = plan.power_scale * dissipated / window / 1000.0;
+  result.torque_nm = result.power_kw * 1000.0 / plan.angular_speed;
+  const double change =
+      (b.kinetic - a.kinetic) + (b.potential - a.potential) + (b.stored - a.stored);
+  result.energy_balance_error = std::abs(work - (change + dissipated)) / std::abs(work);
+  const auto measured = static_cast<std::size_t>(plan.config.measure_revolutions);
+  const std::size_t first =
+      result.revolutions.size() - std::min(measured, result.revolutions.size());
+  double sum = 0.0;
+  double sum_squares = 0.0;
+  for (std::size_t k = first; k < result.revolutions.size(); ++k) {
+    sum += result.revolutions[k].power;
+    sum_squares += result.revolutions[k].power * result.revolutions[k].power;
+  }
+  const double n = static_cast<double>(result.revolutions.size() - first);
+  if (n > 1) {
+    const double mean = sum / n;
+    result.power_std_kw =
+        std::sqrt(std::max(0.0, (sum_squares - n * mean * mean) / (n - 1))) / 1000.0;
+  }
+
+  result.steps = world.steps();
+  result.simulated_seconds = world.time();
+  result.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  result.particle_steps_per_second =
+      static_cast<double>(result.steps) * plan.particle_count / result.wall_seconds;
+  return result;
+}
+
+}  // namespace millsim

@@ -1,0 +1,65 @@
+// A mill job: settle the charge, turn the shell, measure power and collisions.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <vector>
+
+#include "millsim/measure/spectrum.hpp"
+#include "millsim/sim/charge.hpp"
+
+namespace millsim {
+
+/// Energy accounts of the slice at one instant, J.
+struct EnergySample {
+  double time = 0.0;
+  double shell_work = 0.0;
+  double dissipated = 0.0;
+  double kinetic = 0.0;
+  double potential = 0.0;
+  double stored = 0.0;
+};
+
+/// One revolution of the shell (or one interval of the finer time series). Powers are for
+/// the whole mill (the slice scaled by MillPlan::power_scale), in W and N m.
+struct PowerInterval {
+  double start_time = 0.0;
+  double end_time = 0.0;
+  double torque = 0.0;             ///< mean drive torque, N m
+  double power = 0.0;              ///< shell work / duration, W
+  double dissipation_power = 0.0;  ///< energy dissipated / duration, W
+  double kinetic_energy = 0.0;     ///< slice, at the end, J
+};
+
+struct MillResult {
+  MillPlan plan;
+  std::vector<PowerInterval> revolutions;  ///< every whole revolution after settling
+  std::vector<PowerInterval> series;       ///< 50 intervals a revolution, from the start
+  EnergySample window_start;
+  EnergySample window_end;
+  ImpactSpectrum spectrum{};  ///< collisions ending in the measured window (slice)
+  double power_kw = 0.0;
+  double power_dissipation_kw = 0.0;
+  double power_std_kw = 0.0;
+  double torque_nm = 0.0;
+  double energy_balance_error = 0.0;
+  long steps = 0;
+  double simulated_seconds = 0.0;
+  double wall_seconds = 0.0;
+  double particle_steps_per_second = 0.0;
+  double settled_kinetic_energy = 0.0;  ///< J, slice, at the end of settling
+};
+
+/// Called now and then with (simulated time, total time, revolutions so far).
+using ProgressCallback = std::function<void(double, double, double)>;
+
+/// Runs the job on `world` (from build_mill_world(plan)). Snapshots go to
+/// `snapshot_directory` if the plan asks for them (it must exist). Everything else is returned.
+MillResult run_mill(const MillPlan& plan, World<2> world,
+                    const std::filesystem::path& snapshot_directory,
+                    const ProgressCallback& progress = {});
+
+/// Time for the shell to come up to speed: a quarter of a revolution at full speed.
+double spin_up_time(const MillPlan& plan);
+
+}  // namespace millsim

@@ -1,0 +1,104 @@
+// World<D>: particles, walls and contacts, advanced one time step at a time by step(), which
+// runs the named stages of docs/architecture.md and does nothing else.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "millsim/contact/linear_spring_dashpot.hpp"
+#include "millsim/geometry/walls.hpp"
+#include "millsim/measure/spectrum.hpp"
+#include "millsim/particles/material.hpp"
+#include "millsim/particles/particle_store.hpp"
+#include "millsim/search/neighbour_list.hpp"
+
+namespace millsim {
+
+template <int D>
+struct WorldSettings {
+  double time_step = 1e-5;  ///< Δt, s
+  Vec<D> gravity{};         ///< m/s²
+  ContactMaterial ball_ball;
+  ContactMaterial ball_wall;
+  bool allow_tension = false;  ///< see LinearSpringDashpot; false is the model of MODEL.md
+  double skin = 0.0;           ///< neighbour-list skin, m; 0 picks half the smallest radius
+};
+
+/// Energy accounts since the world was made, J. The balance
+/// shell_work = Δkinetic + Δpotential + Δstored + dissipated holds to discretisation error.
+struct EnergyAccount {
+  double shell_work = 0.0;  ///< work done on the particles by the turning shell and lifters
+  double dissipated = 0.0;  ///< dashpots, friction slip and springs forgotten by broken contacts
+};
+
+template <int D>
+class World {
+ public:
+  static constexpr int max_wall_contacts = 4;  ///< per particle: shell and up to three lifters
+
+  World(const WorldSettings<D>& settings, const Walls<D>& walls);
+
+  ParticleStore<D>& particles() { return particles_; }
+  const ParticleStore<D>& particles() const { return particles_; }
+  Walls<D>& walls() { return walls_; }
+  const Walls<D>& walls() const { return walls_; }
+  const WorldSettings<D>& settings() const { return settings_; }
+
+  /// Collisions that end from now on are added to `spectrum` (nullptr: not recorded).
+  void record_collisions_in(ImpactSpectrum* spectrum) { spectrum_ = spectrum; }
+
+  /// Advances the world by one time step.
+  void step();
+
+  double time() const { return time_; }
+  long steps() const { return steps_; }
+  const EnergyAccount& energy_account() const { return account_; }
+  /// Torque the drive applied to the shell in the last step (about +z), N m.
+  double shell_torque() const { return shell_torque_; }
+  /// Energy dissipated in the last step, J.
+  double last_step_dissipation() const { return last_step_dissipation_; }
+  long neighbour_rebuilds() const { return neighbours_.rebuild_count(); }
+  std::size_t touching_contacts() const;
+
+  double kinetic_energy() const;        ///< translation and rotation, J
+  double potential_energy() const;      ///< −Σ m g·x, J
+  double stored_spring_energy() const;  ///< held by the springs of all current contacts, J
+
+ private:
+  // The stages of step(), in order.
+  void refresh_neighbours();
+  void evaluate_pair_contacts();
+  void evaluate_wall_contacts();
+  void accumulate_forces();
+  void integrate();
+  void advance_walls();
+
+  void end_collision(ContactType type, ContactHistory<D>& history);
+
+  WorldSettings<D> settings_;
+  Walls<D> walls_;
+  ParticleStore<D> particles_;
+  LinearSpringDashpot ball_ball_law_;
+  LinearSpringDashpot ball_wall_law_;
+  NeighbourList<D> neighbours_;
+  ImpactSpectrum* spectrum_ = nullptr;
+
+  // Per pair of the neighbour list: force on the second particle and the moment per unit
+  // radius, −n × F_t, that both particles receive (scaled by their radii).
+  std::vector<Vec<D>> pair_force_;
+  std::vector<Spin<D>> pair_moment_;
+  // Per particle, max_wall_contacts slots of wall-contact history keyed by wall id.
+  std::vector<std::int32_t> wall_slot_id_;
+  std::vector<ContactHistory<D>> wall_slot_history_;
+
+  double time_ = 0.0;
+  long steps_ = 0;
+  EnergyAccount account_;
+  double shell_torque_ = 0.0;
+  double last_step_dissipation_ = 0.0;
+};
+
+extern template class World<2>;
+
+}  // namespace millsim
