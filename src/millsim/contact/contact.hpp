@@ -22,8 +22,14 @@ template <int D>
 struct ContactInput {
   Vec<D> normal{};       ///< unit vector from A towards B (from a wall into the particle)
   double overlap = 0.0;  ///< δ > 0, m
-  Vec<D> velocity{};     ///< u̇_B − u̇_A at the contact point from translation alone
-  Vec<D> spin_velocity{};  ///< n × (r_A ω_A + r_B ω_B): the rotational part of the sliding velocity
+  /// u̇_B − u̇_A at the time of the positions (for a wall: minus the wall's velocity there);
+  /// the dashpots use it.
+  Vec<D> velocity{};
+  Vec<D> spin_velocity{};  ///< n × (r_A ω_A + r_B ω_B) at that time: rotation's part of v_s
+  /// The same two over the last step (leapfrog half-step velocities): the tangential spring
+  /// grows by the sliding displacement they make, so that it is the exact integral of it.
+  Vec<D> step_velocity{};
+  Vec<D> step_spin_velocity{};
   double effective_mass = 0.0;  ///< m* = m_A m_B / (m_A + m_B); m of the particle for a wall
 };
 

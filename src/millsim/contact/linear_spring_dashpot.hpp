@@ -41,6 +41,8 @@ class LinearSpringDashpot {
     const Vec<D>& n = in.normal;
     const double normal_speed = dot(in.velocity, n);  // v·n < 0 while the pair approaches
     const Vec<D> sliding_velocity = in.velocity - normal_speed * n + in.spin_velocity;  // v_s
+    const Vec<D> step_sliding_velocity =
+        in.step_velocity - dot(in.step_velocity, n) * n + in.step_spin_velocity;
 
     // Normal: spring k_n (δ − origin) and dashpot D_n = −c_n v_n, c_n = 2 ζ sqrt(k_n m*).
     const double sqrt_mass = std::sqrt(in.effective_mass);
@@ -73,7 +75,7 @@ class LinearSpringDashpot {
 
     // Tangential spring F_s ← R(F_s) − k_s v_s Δt, dashpot D_s = −c_s v_s, Coulomb cap μ F_N
     // on the total normal force F_N (so that the friction impulse is μ times the normal one).
-    spring -= (tangential_stiffness_ * time_step) * sliding_velocity;
+    spring -= (tangential_stiffness_ * time_step) * step_sliding_velocity;
     const double friction_limit = friction_ * std::abs(normal_force);
     const double spring_length = norm(spring);
     if (spring_length > friction_limit) {

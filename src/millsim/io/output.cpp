@@ -109,6 +109,8 @@ std::string summary_json(const MillResult& r) {
       {"slice_charge_mass_kg", plan.slice_mass},
       {"mill_charge_mass_kg", plan.mill_charge_mass},
       {"power_scale", plan.power_scale},
+      {"charge_centre_of_mass_m", toml::array{r.charge_centre[0], r.charge_centre[1]}},
+      {"charge_orbital_speed_ratio", r.orbital_speed_ratio},
       {"discs", discs},
   };
   if (c.reference) {

@@ -33,6 +33,21 @@ PowerInterval interval(const EnergySample& from, const EnergySample& to, double 
   return p;
 }
 
+/// Centre of mass of the particles and their mean angular speed about the origin.
+std::pair<Vec2, double> charge_motion(const World<2>& world) {
+  const auto& p = world.particles();
+  Vec2 moment{};
+  double mass = 0.0;
+  double angular_speed = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    moment += p.mass[i] * p.position[i];
+    mass += p.mass[i];
+    const double r2 = norm_squared(p.position[i]);
+    if (r2 > 0.0) angular_speed += cross(p.position[i], p.velocity[i]) / r2;
+  }
+  return {moment * (1.0 / mass), angular_speed / static_cast<double>(p.size())};
+}
+
 }  // namespace
 
 double spin_up_time(const MillPlan& plan) {
@@ -81,6 +96,7 @@ MillResult run_mill(const MillPlan& plan, World<2> world,
   double series_torque_time = 0.0;
   int next_revolution = 1;
   bool measuring = false;
+  int motion_samples = 0;
   for (;;) {
     const double turned = mill.angle - start_angle;
     if (!measuring && turned >= measure_from - 1e-12) {
@@ -99,6 +115,12 @@ MillResult run_mill(const MillPlan& plan, World<2> world,
     if (now_turned >= series_angle * static_cast<double>(result.series.size() + 1)) {
       const EnergySample now = sample(world);
       result.series.push_back(interval(series_start, now, series_torque_time, plan.power_scale));
+      if (measuring) {
+        const auto [centre, angular_speed] = charge_motion(world);
+        result.charge_centre += centre;
+        result.orbital_speed_ratio += angular_speed / plan.angular_speed;
+        ++motion_samples;
+      }
       series_start = now;
       series_torque_time = 0.0;
     }
@@ -116,6 +138,10 @@ MillResult run_mill(const MillPlan& plan, World<2> world,
   }
   world.record_collisions_in(nullptr);
   result.window_end = sample(world);
+  if (motion_samples > 0) {
+    result.charge_centre *= 1.0 / motion_samples;
+    result.orbital_speed_ratio /= motion_samples;
+  }
 
   // Means over the measured window, spread between its revolutions.
   const EnergySample& a = result.window_start;

@@ -48,6 +48,12 @@ struct MillResult {
   double wall_seconds = 0.0;
   double particle_steps_per_second = 0.0;
   double settled_kinetic_energy = 0.0;  ///< J, slice, at the end of settling
+  /// Centre of mass of the charge averaged over the measured window, m from the mill axis. Its
+  /// horizontal offset times the charge weight is the torque that holds the charge up.
+  Vec2 charge_centre{};
+  /// Mean over the window and the balls of their angular speed about the mill axis divided by
+  /// the shell's: 1 when the charge rides with the shell (centrifuged).
+  double orbital_speed_ratio = 0.0;
 };
 
 /// Called now and then with (simulated time, total time, revolutions so far).

@@ -30,6 +30,7 @@ World<D>::World(const WorldSettings<D>& settings, const Walls<D>& walls)
 template <int D>
 void World<D>::step() {
   refresh_neighbours();
+  estimate_current_velocities();
   evaluate_pair_contacts();
   evaluate_wall_contacts();
   accumulate_forces();
@@ -58,6 +59,20 @@ void World<D>::refresh_neighbours() {
 }
 
 template <int D>
+void World<D>::estimate_current_velocities() {
+  const std::size_t count = particles_.size();
+  velocity_now_.resize(count);
+  spin_now_.resize(count);
+  const double half_step = 0.5 * settings_.time_step;
+  for (std::size_t i = 0; i < count; ++i) {
+    velocity_now_[i] =
+        particles_.velocity[i] + (half_step * particles_.inverse_mass[i]) * particles_.force[i];
+    spin_now_[i] = particles_.angular_velocity[i] +
+                   (half_step * particles_.inverse_inertia[i]) * particles_.torque[i];
+  }
+}
+
+template <int D>
 void World<D>::end_collision(ContactType type, ContactHistory<D>& history) {
   if (spectrum_ != nullptr) spectrum_->record(type, history.dissipated);
   history = ContactHistory<D>{};
@@ -69,8 +84,10 @@ void World<D>::evaluate_pair_contacts() {
   const auto& second = neighbours_.second();
   auto& history = neighbours_.history();
   const auto& x = particles_.position;
-  const auto& v = particles_.velocity;
-  const auto& w = particles_.angular_velocity;
+  const auto& v = velocity_now_;
+  const auto& w = spin_now_;
+  const auto& step_v = particles_.velocity;
+  const auto& step_w = particles_.angular_velocity;
   const auto& r = particles_.radius;
   const auto& m = particles_.mass;
   const double dt = settings_.time_step;
@@ -93,6 +110,8 @@ void World<D>::evaluate_pair_contacts() {
     in.overlap = reach - distance;
     in.velocity = v[b] - v[a];
     in.spin_velocity = cross(in.normal, r[a] * w[a] + r[b] * w[b]);
+    in.step_velocity = step_v[b] - step_v[a];
+    in.step_spin_velocity = cross(in.normal, r[a] * step_w[a] + r[b] * step_w[b]);
     in.effective_mass = m[a] * m[b] / (m[a] + m[b]);
     history[p].touching = true;
     history[p].overlap = in.overlap;
@@ -130,8 +149,10 @@ void World<D>::evaluate_wall_contacts() {
       ContactInput<D> in;
       in.normal = contact.normal;
       in.overlap = contact.overlap;
-      in.velocity = particles_.velocity[i] - contact.wall_velocity;
-      in.spin_velocity = cross(contact.normal, radius * particles_.angular_velocity[i]);
+      in.velocity = velocity_now_[i] - contact.wall_velocity;
+      in.spin_velocity = cross(contact.normal, radius * spin_now_[i]);
+      in.step_velocity = particles_.velocity[i] - contact.wall_velocity;
+      in.step_spin_velocity = cross(contact.normal, radius * particles_.angular_velocity[i]);
       in.effective_mass = particles_.mass[i];
       ContactHistory<D>& history = slot_history[slot];
       history.touching = true;

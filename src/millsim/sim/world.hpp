@@ -68,6 +68,7 @@ class World {
  private:
   // The stages of step(), in order.
   void refresh_neighbours();
+  void estimate_current_velocities();
   void evaluate_pair_contacts();
   void evaluate_wall_contacts();
   void accumulate_forces();
@@ -84,6 +85,11 @@ class World {
   NeighbourList<D> neighbours_;
   ImpactSpectrum* spectrum_ = nullptr;
 
+  // u̇(n) ≈ u̇(n−½) + ½ ü(n−1) Δt and the same for ω: the velocities at the time of the
+  // positions, which the dashpots and springs use so that the work they account for is the
+  // work the leapfrog update does (docs/model.md, "energy account").
+  std::vector<Vec<D>> velocity_now_;
+  std::vector<Spin<D>> spin_now_;
   // Per pair of the neighbour list: force on the second particle and the moment per unit
   // radius, −n × F_t, that both particles receive (scaled by their radii).
   std::vector<Vec<D>> pair_force_;
