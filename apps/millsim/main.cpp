@@ -77,6 +77,11 @@ MillResult run_job(const MillConfig& config, bool show_progress) {
   const MillPlan plan = millsim::plan_mill(config);
   millsim::World<2> world = millsim::build_mill_world(plan);
   const std::filesystem::path out = config.output_directory;
+  if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
+    throw millsim::InputError(fmt::format(
+        "{}: output.directory: \"{}\" exists and is not a directory; allowed: a directory path",
+        config.location_of("output.directory"), config.output_directory));
+  }
   std::filesystem::create_directories(out);
   const std::filesystem::path snapshots = out / "snapshots";
   std::filesystem::remove_all(snapshots);
@@ -208,7 +213,14 @@ int main(int argc, char** argv) {
                        "where the runs go (default runs/validation)");
   add_job_options(*validate, options);
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    if (error.get_exit_code() == 0) return app.exit(error);  // --help
+    fmt::print(stderr, "millsim: error: command line: {}; allowed: see millsim --help\n",
+               error.what());
+    return 2;
+  }
   try {
     if (run->parsed()) return run_command(options);
     if (info->parsed()) return info_command(options);

@@ -3,8 +3,13 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "millsim/core/constants.hpp"
@@ -18,73 +23,148 @@ bool positive(double x) {
   return x > 0.0;
 }
 
+/// The keys of every table, to say where a key put in the wrong table belongs.
+struct KnownTable {
+  std::string_view name;
+  std::vector<std::string_view> keys;
+};
+
+const std::vector<KnownTable>& known_tables() {
+  static const std::vector<KnownTable> tables = {
+      {"simulation",
+       {"dimension", "time_step", "settle_time", "revolutions", "measure_revolutions", "seed"}},
+      {"mill", {"diameter", "length", "speed", "speed_rpm", "lifters"}},
+      {"mill.lifters", {"count", "height", "width"}},
+      {"charge", {"filling", "porosity", "density", "ball_diameter", "top_size", "sizes"}},
+      {"materials", {"ball_ball", "ball_wall"}},
+      {"materials.ball_ball] or [materials.ball_wall",
+       {"normal_stiffness", "tangential_stiffness", "restitution", "friction"}},
+      {"output", {"directory", "snapshot_interval"}},
+      {"reference", {"case", "measured_power_kw", "paper_power_kw", "tolerance"}},
+  };
+  return tables;
+}
+
+/// "it belongs in [charge]" for a key that another table has, or "did you mean height in
+/// [mill.lifters]?" for one close to a key of another table; empty if there is none.
+std::string belongs_elsewhere(std::string_view key) {
+  for (const KnownTable& table : known_tables()) {
+    if (std::find(table.keys.begin(), table.keys.end(), key) != table.keys.end()) {
+      return fmt::format("it belongs in [{}]", table.name);
+    }
+  }
+  for (const KnownTable& table : known_tables()) {
+    if (const auto near = closest_key(key, table.keys)) {
+      return fmt::format("did you mean {} in [{}]?", *near, table.name);
+    }
+  }
+  return {};
+}
+
 void read_simulation(TableReader section, MillConfig& config) {
+  section.allow_keys(
+      {"dimension", "time_step", "settle_time", "revolutions", "measure_revolutions", "seed"},
+      belongs_elsewhere);
   config.dimension = static_cast<int>(section.integer(
       "dimension", 2, "2 (3D comes in a later version)", [](long d) { return d == 2 || d == 3; }));
   if (config.dimension == 3) {
-    section.fail_at("dimension", "3D mills are not available yet in this version; allowed: 2");
+    section.fail_at("dimension",
+                    "3 (a 3D mill) is not available yet in this version; allowed: 2 (a 2D slice "
+                    "of the mill)");
   }
+  const std::string step_rule = "\"auto\" or a number of seconds > 0";
   if (const toml::node* step = section.node("time_step")) {
     if (step->is_string()) {
       if (step->as_string()->get() != "auto") {
-        section.fail_at("time_step", fmt::format("\"{}\" is not allowed; allowed: \"auto\" or a "
-                                                 "number of seconds > 0",
-                                                 step->as_string()->get()));
+        section.fail_at("time_step", fmt::format("{} is not allowed; allowed: {}",
+                                                 describe_value(*step), step_rule));
       }
     } else {
-      config.time_step = section.number("time_step", std::nullopt,
-                                        "\"auto\" or a number of seconds > 0", positive);
+      config.time_step = section.number("time_step", std::nullopt, step_rule, positive);
     }
   }
-  config.settle_time = section.number("settle_time", 1.0, "a number of seconds >= 0",
+  config.settle_time = section.number("settle_time", 1.0, "a number of seconds >= 0, at most 1e4",
                                       [](double t) { return t >= 0.0 && t <= 1e4; });
+  // At least one revolution: measure_revolutions (a whole number >= 1) are measured of them.
   config.revolutions =
-      section.number("revolutions", 6.0, "a number of revolutions > 0, at most 1e5",
-                     [](double n) { return n > 0.0 && n <= 1e5; });
-  config.measure_revolutions = static_cast<int>(section.integer(
-      "measure_revolutions", 4,
-      "a whole number of revolutions >= 1, at most simulation.revolutions",
-      [&](long n) { return n >= 1 && static_cast<double>(n) <= config.revolutions; }));
+      section.number("revolutions", 6.0, "a number of revolutions >= 1, at most 1e5",
+                     [](double n) { return n >= 1.0 && n <= 1e5; });
+  const long most = static_cast<long>(std::floor(config.revolutions));
+  const std::string measure_rule =
+      fmt::format("a whole number of revolutions from 1 to {} (simulation.revolutions)", most);
+  const bool measure_given = section.has("measure_revolutions");
+  const long measure =
+      section.integer("measure_revolutions", 4, measure_rule, [](long n) { return n >= 1; });
+  if (measure > most) {
+    const std::string revolutions =
+        fmt::format("simulation.revolutions = {} ({})", config.revolutions,
+                    section.has("revolutions") ? section.location("revolutions") : "default");
+    if (measure_given) {
+      section.fail_at("measure_revolutions", fmt::format("{} is more than {}; allowed: {}", measure,
+                                                         revolutions, measure_rule));
+    }
+    throw InputError(fmt::format(
+        "{}: simulation.measure_revolutions: not given, and its default {} is more than "
+        "simulation.revolutions = {}; allowed: set measure_revolutions to a whole number of "
+        "revolutions from 1 to {}",
+        section.location("revolutions"), measure, config.revolutions, most));
+  }
+  config.measure_revolutions = static_cast<int>(measure);
   config.seed = static_cast<std::uint64_t>(
       section.integer("seed", 1, "a whole number >= 0", [](long s) { return s >= 0; }));
-  section.refuse_unknown_keys(
-      "dimension, time_step, settle_time, revolutions, measure_revolutions, seed");
+}
+
+void read_lifters(TableReader lifters, MillConfig& config) {
+  lifters.allow_keys({"count", "height", "width"}, belongs_elsewhere);
+  const double radius = 0.5 * config.diameter;
+  const bool shaped = lifters.has("height") || lifters.has("width");
+  config.lifter_count = static_cast<int>(
+      lifters.integer("count", shaped ? std::nullopt : std::optional<long>(0),
+                      shaped ? "a whole number from 0 to 360 (needed when height or width is given)"
+                             : "a whole number from 0 to 360 (0 = a smooth shell)",
+                      [](long n) { return n >= 0 && n <= 360; }));
+  const std::string height_rule = fmt::format(
+      "a number of metres > 0 and < {} (the mill radius; taller lifters would fill the mill)",
+      radius);
+  const auto height_fits = [&](double h) { return h > 0.0 && h < radius; };
+  if (config.lifter_count == 0) {
+    // A smooth shell (e.g. --set mill.lifters.count=0): the lifter shape is not used, but it
+    // must still make sense.
+    lifters.optional_number("height", height_rule, height_fits);
+    lifters.optional_number("width", "a number of metres > 0", positive);
+    return;
+  }
+  config.lifter_height = lifters.number(
+      "height", std::nullopt,
+      fmt::format("{}; needed because count = {}", height_rule, config.lifter_count), height_fits);
+  const double inner_circumference = 2.0 * pi * (radius - config.lifter_height);
+  const double widest = inner_circumference / config.lifter_count;
+  config.lifter_width = lifters.number(
+      "width", std::nullopt,
+      fmt::format("a number of metres > 0 and < {:.4g} (wider, {} lifters {} m high would "
+                  "overlap at their inner faces)",
+                  widest, config.lifter_count, config.lifter_height),
+      [&](double w) { return w > 0.0 && w < widest; });
 }
 
 void read_mill(TableReader section, MillConfig& config) {
-  config.diameter = section.number("diameter", std::nullopt, "a number of metres > 0", positive);
+  section.allow_keys({"diameter", "length", "speed", "speed_rpm", "lifters"}, belongs_elsewhere);
+  config.diameter = section.number("diameter", std::nullopt,
+                                   "a number of metres > 0 (inside the shell)", positive);
   config.length = section.number("length", std::nullopt, "a number of metres > 0", positive);
+  const std::string speed_rule = "a fraction of critical speed > 0, at most 5";
+  const std::string rpm_rule = "a number of rpm > 0";
   config.speed_fraction =
-      section.optional_number("speed", "a fraction of critical speed > 0, at most 5",
-                              [](double s) { return s > 0.0 && s <= 5.0; });
-  config.speed_rpm = section.optional_number("speed_rpm", "a number of rpm > 0", positive);
+      section.optional_number("speed", speed_rule, [](double s) { return s > 0.0 && s <= 5.0; });
+  config.speed_rpm = section.optional_number("speed_rpm", rpm_rule, positive);
+  const std::string either =
+      fmt::format("either mill.speed ({}) or mill.speed_rpm ({}), not both", speed_rule, rpm_rule);
   if (config.speed_fraction && config.speed_rpm) {
-    section.fail_at("speed_rpm",
-                    "give either mill.speed (fraction of critical) or "
-                    "mill.speed_rpm, not both");
+    section.fail_at("speed_rpm", fmt::format("given as well as mill.speed ({}); allowed: {}",
+                                             section.location("speed"), either));
   }
-  if (!config.speed_fraction && !config.speed_rpm) {
-    section.fail_missing("speed", "mill.speed (fraction of critical speed) or mill.speed_rpm");
-  }
-  TableReader lifters = section.table("lifters", false);
-  const double radius = 0.5 * config.diameter;
-  config.lifter_count = static_cast<int>(lifters.integer(
-      "count", 0, "a whole number from 0 to 360", [](long n) { return n >= 0 && n <= 360; }));
-  if (config.lifter_count > 0) {
-    config.lifter_height = lifters.number(
-        "height", std::nullopt, fmt::format("a number of metres > 0 and < {} (the radius)", radius),
-        [&](double h) { return h > 0.0 && h < radius; });
-    const double inner_circumference = 2.0 * pi * (radius - config.lifter_height);
-    const double widest = inner_circumference / config.lifter_count;
-    config.lifter_width = lifters.number(
-        "width", std::nullopt,
-        fmt::format("a number of metres > 0 and < {:.4g} ({} lifters must not touch at their "
-                    "faces)",
-                    widest, config.lifter_count),
-        [&](double w) { return w > 0.0 && w < widest; });
-  }
-  lifters.refuse_unknown_keys("count, height, width");
-  section.refuse_unknown_keys("diameter, length, speed, speed_rpm, lifters");
+  if (!config.speed_fraction && !config.speed_rpm) section.fail_missing("speed", either);
+  read_lifters(section.table("lifters", false), config);
 }
 
 void read_sizes(TableReader& section, MillConfig& config) {
@@ -92,13 +172,17 @@ void read_sizes(TableReader& section, MillConfig& config) {
   const std::string size_rule =
       fmt::format("a number of metres > 0 and < {} (half the mill radius)", 0.5 * radius);
   const auto fits = [&](double d) { return d > 0.0 && d < 0.5 * radius; };
-  const int given = (section.has("ball_diameter") ? 1 : 0) + (section.has("top_size") ? 1 : 0) +
-                    (section.has("sizes") ? 1 : 0);
-  const std::string choices = "one of ball_diameter (one size), top_size (graded) or sizes (list)";
-  if (given == 0) section.fail_missing("ball_diameter", choices);
-  if (given > 1) {
-    section.fail_at(section.has("sizes") ? "sizes" : "top_size",
-                    "give " + choices + ", not several");
+  const std::string choices =
+      "one of ball_diameter (one size), top_size (a graded charge) or sizes (a list)";
+  std::vector<std::string_view> given;
+  for (const std::string_view key : {"ball_diameter", "top_size", "sizes"}) {
+    if (section.has(key)) given.push_back(key);
+  }
+  if (given.empty()) section.fail_missing("ball_diameter", choices);
+  if (given.size() > 1) {
+    section.fail_at(given[1], fmt::format("given as well as charge.{} ({}); allowed: {}, not "
+                                          "several",
+                                          given[0], section.location(given[0]), choices));
   }
   if (section.has("ball_diameter")) {
     config.sizes = {{section.number("ball_diameter", std::nullopt, size_rule, fits), 1.0}};
@@ -112,41 +196,55 @@ void read_sizes(TableReader& section, MillConfig& config) {
     const std::string list_rule =
         "a non-empty array of tables {diameter = metres, mass_fraction = 0..1} whose fractions "
         "sum to 1";
-    if (!list->is_array() || list->as_array()->empty())
-      section.fail_at("sizes", "expected " + list_rule);
+    if (!list->is_array() || list->as_array()->empty()) {
+      section.fail_at("sizes", fmt::format("{} is not allowed; allowed: {}",
+                                           list->is_array() ? std::string("an empty array")
+                                                            : describe_value(*list),
+                                           list_rule));
+    }
     double total = 0.0;
     int index = 0;
     for (const toml::node& entry : *list->as_array()) {
-      if (!entry.is_table()) section.fail_at("sizes", "expected " + list_rule);
-      TableReader size(*entry.as_table(), fmt::format("{}.sizes[{}]", section.path(), index++),
-                       section.file());
+      const std::string name = fmt::format("{}[{}]", section.dotted("sizes"), index++);
+      if (!entry.is_table()) {
+        section.fail_at_node(entry, name,
+                             fmt::format("{} is not allowed; allowed: a table {{diameter = "
+                                         "metres, mass_fraction = 0..1}}",
+                                         describe_value(entry)));
+      }
+      TableReader size(*entry.as_table(), name, section.file());
+      size.allow_keys({"diameter", "mass_fraction"});
       SizeClass c;
       c.diameter = size.number("diameter", std::nullopt, size_rule, fits);
       c.mass_fraction = size.number("mass_fraction", std::nullopt, "a number > 0 and <= 1",
                                     [](double f) { return f > 0.0 && f <= 1.0; });
-      size.refuse_unknown_keys("diameter, mass_fraction");
       total += c.mass_fraction;
       config.sizes.push_back(c);
     }
     if (std::abs(total - 1.0) > 1e-3) {
-      section.fail_at("sizes",
-                      fmt::format("mass fractions sum to {:.4g}; they must sum to 1", total));
+      section.fail_at("sizes", fmt::format("the mass fractions sum to {:.4g}; allowed: mass "
+                                           "fractions that sum to 1 (within 0.001)",
+                                           total));
     }
     config.size_description = fmt::format("{} sizes given", config.sizes.size());
   }
 }
 
 void read_charge(TableReader section, MillConfig& config) {
-  config.filling = section.number("filling", std::nullopt, "a fraction > 0 and < 1",
-                                  [](double j) { return j > 0.0 && j < 1.0; });
+  section.allow_keys({"filling", "porosity", "density", "ball_diameter", "top_size", "sizes"},
+                     belongs_elsewhere);
+  config.filling =
+      section.number("filling", std::nullopt, "a fraction of the mill volume > 0 and < 1",
+                     [](double j) { return j > 0.0 && j < 1.0; });
   config.porosity = section.number("porosity", 0.4, "a fraction >= 0 and < 1",
                                    [](double p) { return p >= 0.0 && p < 1.0; });
   config.density = section.number("density", 7800.0, "a number of kg/m3 > 0", positive);
   read_sizes(section, config);
-  section.refuse_unknown_keys("filling, porosity, density, ball_diameter, top_size, sizes");
 }
 
 ContactMaterial read_material(TableReader section) {
+  section.allow_keys({"normal_stiffness", "tangential_stiffness", "restitution", "friction"},
+                     belongs_elsewhere);
   ContactMaterial m;
   m.normal_stiffness =
       section.number("normal_stiffness", m.normal_stiffness, "a number of N/m > 0", positive);
@@ -156,26 +254,30 @@ ContactMaterial read_material(TableReader section) {
                                  [](double e) { return e > 0.0 && e <= 1.0; });
   m.friction = section.number("friction", m.friction, "a number >= 0 and <= 10",
                               [](double mu) { return mu >= 0.0 && mu <= 10.0; });
-  section.refuse_unknown_keys("normal_stiffness, tangential_stiffness, restitution, friction");
   return m;
 }
 
 void read_output(TableReader section, MillConfig& config) {
-  config.output_directory = section.string("directory", "out", "a directory path (string)");
-  if (config.output_directory.empty()) section.fail_at("directory", "must not be empty");
+  section.allow_keys({"directory", "snapshot_interval"}, belongs_elsewhere);
+  const std::string directory_rule = "a directory path (a non-empty string)";
+  config.output_directory = section.string("directory", "out", directory_rule);
+  if (config.output_directory.empty()) {
+    section.fail_at("directory",
+                    fmt::format("an empty path is not allowed; allowed: {}", directory_rule));
+  }
   config.snapshot_interval =
       section.number("snapshot_interval", 0.05, "a number of seconds >= 0 (0 = no snapshots)",
                      [](double t) { return t >= 0.0; });
-  section.refuse_unknown_keys("directory, snapshot_interval");
 }
 
 void read_reference(TableReader section, MillConfig& config) {
+  section.allow_keys({"case", "measured_power_kw", "paper_power_kw", "tolerance"},
+                     belongs_elsewhere);
   ReferencePower r;
-  r.case_name = section.string("case", std::nullopt, "the case name (string)");
+  r.case_name = section.string("case", std::nullopt, "the case name (a string)");
   r.measured_kw = section.number("measured_power_kw", std::nullopt, "a number of kW > 0", positive);
   r.paper_kw = section.optional_number("paper_power_kw", "a number of kW > 0", positive);
   r.tolerance = section.number("tolerance", 0.15, "a fraction > 0", positive);
-  section.refuse_unknown_keys("case, measured_power_kw, paper_power_kw, tolerance");
   config.reference = r;
 }
 
@@ -197,38 +299,69 @@ std::vector<SizeClass> graded_charge(double top_size) {
   return sizes;
 }
 
+std::string MillConfig::location_of(std::string_view dotted_key) const {
+  const auto found = key_locations.find(dotted_key);
+  return found != key_locations.end() ? found->second : source;
+}
+
 MillConfig parse_mill_config(std::string_view toml_text, const std::string& source,
                              const std::vector<std::string>& overrides) {
   toml::table document;
   try {
     document = toml::parse(toml_text, std::string_view(source));
   } catch (const toml::parse_error& error) {
-    throw InputError(fmt::format("{}:{}: not valid TOML: {}", source, error.source().begin.line,
-                                 error.description()));
+    throw InputError(fmt::format(
+        "{}:{}: not valid TOML (column {}): {}; allowed: TOML syntax "
+        "(https://toml.io), as in examples/lab-mill-2d.toml",
+        source, error.source().begin.line, error.source().begin.column, error.description()));
   }
   apply_overrides(document, overrides);
 
   MillConfig config;
   config.source = source;
-  TableReader root(document, "", source);
+  TableReader root(document, "", source, &config.key_locations);
+  root.allow_keys({"simulation", "mill", "charge", "materials", "output", "reference"},
+                  belongs_elsewhere);
   read_simulation(root.table("simulation", false), config);
-  read_mill(root.table("mill", true), config);
-  read_charge(root.table("charge", true), config);
+  read_mill(root.table("mill", true,
+                       "a table [mill] with diameter, length, speed or speed_rpm, and "
+                       "[mill.lifters]"),
+            config);
+  read_charge(root.table("charge", true,
+                         "a table [charge] with filling and one of ball_diameter, top_size or "
+                         "sizes"),
+              config);
   TableReader materials = root.table("materials", false);
+  materials.allow_keys({"ball_ball", "ball_wall"}, belongs_elsewhere);
   config.ball_ball = read_material(materials.table("ball_ball", false));
   config.ball_wall = read_material(materials.table("ball_wall", false));
-  materials.refuse_unknown_keys("ball_ball, ball_wall");
   read_output(root.table("output", false), config);
   if (root.has("reference")) read_reference(root.table("reference", false), config);
-  root.refuse_unknown_keys("simulation, mill, charge, materials, output, reference");
   return config;
 }
 
 MillConfig load_mill_config(const std::string& path, const std::vector<std::string>& overrides) {
-  std::ifstream file(path);
-  if (!file) throw InputError(fmt::format("{}: cannot open the config file", path));
+  const std::string allowed =
+      "the path of a mill config file (TOML), e.g. examples/lab-mill-2d.toml";
+  std::error_code error;
+  const auto status = std::filesystem::status(path, error);
+  if (!std::filesystem::exists(status)) {
+    throw InputError(fmt::format("{}: no such config file; allowed: {}", path, allowed));
+  }
+  if (std::filesystem::is_directory(status)) {
+    throw InputError(
+        fmt::format("{}: is a directory, not a config file; allowed: {}", path, allowed));
+  }
+  std::ifstream file(path, std::ios::binary);
+  if (!file) {
+    throw InputError(fmt::format("{}: cannot open the config file ({}); allowed: {}", path,
+                                 std::strerror(errno), allowed));
+  }
   std::ostringstream text;
   text << file.rdbuf();
+  if (file.bad()) {
+    throw InputError(fmt::format("{}: cannot read the config file; allowed: {}", path, allowed));
+  }
   return parse_mill_config(text.str(), path, overrides);
 }
 

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -60,6 +62,16 @@ struct MillConfig {
   double snapshot_interval = 0.05;  ///< s; 0 = none
 
   std::optional<ReferencePower> reference;
+
+  /// Where each key that was given came from, by dotted name: "lab.toml:14", or
+  /// "command line (--set mill.speed=0.7)" for an override. Keys left at their defaults are
+  /// absent.
+  std::map<std::string, std::string, std::less<>> key_locations;
+
+  /// Where `dotted_key` was given, for a message about it found after reading (an unstable
+  /// time step, a charge that does not fit): as in key_locations, or `source` for a key left
+  /// at its default. Use as "{location_of(key)}: {key}: message; allowed: ...".
+  std::string location_of(std::string_view dotted_key) const;
 };
 
 /// Reads a mill config from TOML text. `source` names it in messages. Throws InputError.

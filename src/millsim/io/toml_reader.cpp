@@ -2,7 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <memory>
+#include <utility>
 
 #include "millsim/core/error.hpp"
 
@@ -10,6 +14,38 @@ namespace millsim {
 namespace {
 
 constexpr std::string_view override_prefix = "--set ";
+constexpr std::string_view override_allowed =
+    "KEY=VALUE with a dotted config key, e.g. --set mill.speed=0.75";
+
+bool from_override(const toml::node& node) {
+  const auto& path = node.source().path;
+  return path && path->starts_with(override_prefix);
+}
+
+std::string_view trim(std::string_view text) {
+  constexpr std::string_view blank = " \t\r\n";
+  const auto first = text.find_first_not_of(blank);
+  if (first == std::string_view::npos) return {};
+  const auto last = text.find_last_not_of(blank);
+  return text.substr(first, last - first + 1);
+}
+
+/// `text` with control characters escaped, so that a message stays on one line.
+std::string printable(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      out += fmt::format("\\x{:02x}", static_cast<unsigned>(static_cast<unsigned char>(c)));
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
 
 std::string type_name(const toml::node& node) {
   switch (node.type()) {
@@ -30,11 +66,21 @@ std::string type_name(const toml::node& node) {
   }
 }
 
+/// The value as the user wrote it, for scalars; its kind otherwise.
 std::string describe(const toml::node& node) {
-  if (const auto* s = node.as_string()) return fmt::format("\"{}\"", s->get());
+  if (const auto* s = node.as_string()) return fmt::format("\"{}\"", printable(s->get()));
   if (const auto* i = node.as_integer()) return fmt::format("{}", i->get());
   if (const auto* f = node.as_floating_point()) return fmt::format("{}", f->get());
+  if (const auto* b = node.as_boolean()) return b->get() ? "true" : "false";
   return type_name(node);
+}
+
+/// "\"0.9\" is a string", "a table is not allowed here": the first half of a type error.
+std::string wrong_type(const toml::node& node) {
+  if (node.is_string() || node.is_number() || node.is_boolean()) {
+    return fmt::format("{} is {}", describe(node), type_name(node));
+  }
+  return fmt::format("{} is not allowed here", type_name(node));
 }
 
 const toml::table& empty_table() {
@@ -42,24 +88,142 @@ const toml::table& empty_table() {
   return empty;
 }
 
+/// Optimal string alignment distance (edits, counting a swap of neighbours as one).
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  const std::size_t n = a.size();
+  const std::size_t m = b.size();
+  std::vector<std::vector<std::size_t>> d(n + 1, std::vector<std::size_t>(m + 1));
+  for (std::size_t i = 0; i <= n; ++i) d[i][0] = i;
+  for (std::size_t j = 0; j <= m; ++j) d[0][j] = j;
+  for (std::size_t i = 1; i <= n; ++i) {
+    for (std::size_t j = 1; j <= m; ++j) {
+      const auto lower = [](char c) { return std::tolower(static_cast<unsigned char>(c)); };
+      const std::size_t cost = lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1;
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+      if (i > 1 && j > 1 && lower(a[i - 1]) == lower(b[j - 2]) &&
+          lower(a[i - 2]) == lower(b[j - 1])) {
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+      }
+    }
+  }
+  return d[n][m];
+}
+
+/// The allowed key closest to `key`, if it is close enough to be a likely misspelling.
 }  // namespace
+
+std::optional<std::string_view> closest_key(std::string_view key,
+                                            std::span<const std::string_view> keys) {
+  std::optional<std::string_view> best;
+  std::size_t best_distance = key.size() < 5 ? 1 : 2;
+  for (const std::string_view candidate : keys) {
+    const std::size_t distance = edit_distance(key, candidate);
+    if (distance <= best_distance && (!best || distance < edit_distance(key, *best))) {
+      best = candidate;
+      best_distance = distance;
+    }
+  }
+  return best;
+}
+
+namespace {
+
+bool valid_key_part(std::string_view part) {
+  return !part.empty() && std::all_of(part.begin(), part.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-';
+  });
+}
+
+/// A TOML document `value = <text>` whose nodes name `option` as their source.
+toml::table parse_override_value(std::string_view text, const std::string& option) {
+  try {
+    return toml::parse(fmt::format("value = {}", text), std::string_view(option));
+  } catch (const toml::parse_error&) {
+    // Not a TOML value: take the text as a plain string.
+  }
+  std::string quoted;
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      quoted += '\\';
+      quoted += c;
+    } else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      quoted += fmt::format("\\u{:04x}", static_cast<unsigned>(static_cast<unsigned char>(c)));
+    } else {
+      quoted += c;
+    }
+  }
+  try {
+    return toml::parse(fmt::format("value = \"{}\"", quoted), std::string_view(option));
+  } catch (const toml::parse_error& error) {
+    throw InputError(fmt::format("command line ({}): cannot read the value ({}); allowed: {}",
+                                 option, error.description(), override_allowed));
+  }
+}
+
+}  // namespace
+
+std::string describe_value(const toml::node& node) {
+  return describe(node);
+}
 
 std::string source_location(const toml::node& node, std::string_view fallback_file) {
   const auto& source = node.source();
-  if (source.path && source.path->starts_with(override_prefix)) {
-    return fmt::format("command line ({})", *source.path);
-  }
+  if (from_override(node)) return fmt::format("command line ({})", *source.path);
   const std::string_view file =
       source.path && !source.path->empty() ? std::string_view(*source.path) : fallback_file;
   if (source.begin.line == 0) return std::string(file);
   return fmt::format("{}:{}", file, source.begin.line);
 }
 
-TableReader::TableReader(const toml::table& table, std::string path, std::string file)
-    : table_(&table), path_(std::move(path)), file_(std::move(file)) {}
+TableReader::TableReader(const toml::table& table, std::string path, std::string file,
+                         KeyLocations* locations)
+    : TableReader(table, std::move(path), std::move(file), locations, {}, true) {
+  // The document root starts on line 1 whatever it holds; name only the file for it.
+  where_ = path_.empty() ? file_ : source_location(table, file_);
+}
+
+TableReader::TableReader(const toml::table& table, std::string path, std::string file,
+                         KeyLocations* locations, std::string where, bool present)
+    : table_(&table),
+      path_(std::move(path)),
+      file_(std::move(file)),
+      locations_(locations),
+      where_(std::move(where)),
+      present_(present) {}
 
 std::string TableReader::dotted(std::string_view key) const {
   return path_.empty() ? std::string(key) : fmt::format("{}.{}", path_, key);
+}
+
+std::string TableReader::table_name() const {
+  if (path_.empty()) return "the top level";
+  if (path_.find('[') != std::string::npos) return path_;  // an element of an array
+  return fmt::format("[{}]", path_);
+}
+
+void TableReader::allow_keys(std::initializer_list<std::string_view> keys,
+                             const std::function<std::string(std::string_view)>& hint) {
+  std::string list;
+  for (const std::string_view k : keys)
+    list += list.empty() ? std::string(k) : fmt::format(", {}", k);
+  for (const auto& [key, value] : *table_) {
+    const std::string_view name = key.str();
+    if (std::find(keys.begin(), keys.end(), name) != keys.end()) continue;
+    std::string remark;
+    if (const auto near = closest_key(name, keys)) {
+      remark = fmt::format(" (did you mean {}?)", *near);
+    } else if (hint) {
+      const std::string h = hint(name);
+      if (!h.empty()) remark = fmt::format(" ({})", h);
+    }
+    const std::string where = source_location(value, file_);
+    if (path_.empty()) {
+      throw InputError(fmt::format("{}: {}: unknown {}{}; allowed at the top level: the tables {}",
+                                   where, name, value.is_table() ? "table" : "key", remark, list));
+    }
+    throw InputError(fmt::format("{}: {}: unknown key{}; allowed in {}: {}", where, dotted(name),
+                                 remark, table_name(), list));
+  }
 }
 
 bool TableReader::has(std::string_view key) const {
@@ -67,31 +231,56 @@ bool TableReader::has(std::string_view key) const {
 }
 
 const toml::node* TableReader::node(std::string_view key) {
-  asked_.emplace(key);
-  return table_->get(key);
+  const toml::node* n = table_->get(key);
+  if (n != nullptr && locations_ != nullptr) {
+    (*locations_)[dotted(key)] = source_location(*n, file_);
+  }
+  return n;
+}
+
+std::string TableReader::location(std::string_view key) const {
+  const toml::node* at = table_->get(key);
+  return at != nullptr ? source_location(*at, file_) : where_;
 }
 
 void TableReader::fail_at(std::string_view key, const std::string& message) const {
-  const toml::node* at = table_->get(key);
-  const std::string where =
-      source_location(at ? *at : static_cast<const toml::node&>(*table_), file_);
-  throw InputError(fmt::format("{}: {}: {}", where, dotted(key), message));
+  throw InputError(fmt::format("{}: {}: {}", location(key), dotted(key), message));
+}
+
+void TableReader::fail_at_node(const toml::node& at, std::string_view label,
+                               const std::string& message) const {
+  throw InputError(fmt::format("{}: {}: {}", source_location(at, file_), label, message));
 }
 
 void TableReader::fail_missing(std::string_view key, std::string_view allowed) const {
-  const std::string where = source_location(*table_, file_);
-  const std::string table_name = path_.empty() ? "the top level" : fmt::format("[{}]", path_);
-  throw InputError(fmt::format("{}: {}: missing required key in {}; allowed: {}", where,
-                               dotted(key), table_name, allowed));
+  if (path_.empty()) {
+    throw InputError(
+        fmt::format("{}: {}: missing required table [{}]; allowed: {}", file_, key, key, allowed));
+  }
+  if (!present_) {
+    throw InputError(
+        fmt::format("{}: {}: missing required key, and there is no {} table; "
+                    "allowed: {}",
+                    file_, dotted(key), table_name(), allowed));
+  }
+  if (from_override(*table_)) {
+    // The table exists only because an override put a key in it.
+    throw InputError(
+        fmt::format("{}: {}: missing required key; {} is not in the file, only in "
+                    "{}; allowed: {}",
+                    file_, dotted(key), table_name(), where_, allowed));
+  }
+  throw InputError(
+      fmt::format("{}: {}: missing required key in {}, which starts on this line; "
+                  "allowed: {}",
+                  where_, dotted(key), table_name(), allowed));
 }
 
 std::optional<double> TableReader::optional_number(std::string_view key, std::string_view allowed,
                                                    const std::function<bool(double)>& valid) {
   const toml::node* n = node(key);
   if (n == nullptr) return std::nullopt;
-  if (!n->is_number()) {
-    fail_at(key, fmt::format("expected {}, got {}", allowed, type_name(*n)));
-  }
+  if (!n->is_number()) fail_at(key, fmt::format("{}; allowed: {}", wrong_type(*n), allowed));
   const double value = n->value<double>().value_or(0.0);
   if (!std::isfinite(value) || !valid(value)) {
     fail_at(key, fmt::format("{} is not allowed; allowed: {}", describe(*n), allowed));
@@ -114,8 +303,20 @@ long TableReader::integer(std::string_view key, std::optional<long> fallback,
     if (!fallback) fail_missing(key, allowed);
     return *fallback;
   }
-  if (!n->is_integer()) fail_at(key, fmt::format("expected {}, got {}", allowed, describe(*n)));
-  const long value = static_cast<long>(n->as_integer()->get());
+  long value = 0;
+  if (const auto* i = n->as_integer()) {
+    value = static_cast<long>(i->get());
+  } else if (const auto* f = n->as_floating_point()) {
+    // 8.0 is a whole number written as a float; 8.5, nan and 1e300 are not.
+    constexpr double exact = 9007199254740992.0;  // 2^53
+    const double x = f->get();
+    if (!std::isfinite(x) || std::floor(x) != x || std::abs(x) > exact) {
+      fail_at(key, fmt::format("{} is not a whole number; allowed: {}", describe(*n), allowed));
+    }
+    value = static_cast<long>(x);
+  } else {
+    fail_at(key, fmt::format("{}; allowed: {}", wrong_type(*n), allowed));
+  }
   if (!valid(value)) fail_at(key, fmt::format("{} is not allowed; allowed: {}", value, allowed));
   return value;
 }
@@ -127,82 +328,87 @@ std::string TableReader::string(std::string_view key, std::optional<std::string>
     if (!fallback) fail_missing(key, allowed);
     return *fallback;
   }
-  if (!n->is_string()) fail_at(key, fmt::format("expected {}, got {}", allowed, type_name(*n)));
-  return n->as_string()->get();
+  if (const auto* s = n->as_string()) return s->get();
+  if (from_override(*n) && !n->is_table()) {
+    // "--set output.directory=2024": the text after '=' as typed.
+    const std::string& option = *n->source().path;
+    return std::string(trim(std::string_view(option).substr(option.find('=') + 1)));
+  }
+  fail_at(key, fmt::format("{}; allowed: {}", wrong_type(*n), allowed));
 }
 
-TableReader TableReader::table(std::string_view key, bool required) {
+TableReader TableReader::table(std::string_view key, bool required, std::string_view allowed) {
+  const std::string description =
+      allowed.empty() ? fmt::format("a table [{}]", dotted(key)) : std::string(allowed);
   const toml::node* n = node(key);
   if (n == nullptr) {
-    if (required) fail_missing(key, fmt::format("a table [{}]", dotted(key)));
-    return TableReader(empty_table(), dotted(key), file_);
+    if (required) fail_missing(key, description);
+    return TableReader(empty_table(), dotted(key), file_, locations_, where_, false);
   }
-  if (!n->is_table()) fail_at(key, fmt::format("expected a table, got {}", type_name(*n)));
-  return TableReader(*n->as_table(), dotted(key), file_);
-}
-
-void TableReader::refuse_unknown_keys(std::string_view allowed_keys) const {
-  for (const auto& [key, value] : *table_) {
-    if (asked_.contains(key.str())) continue;
-    const std::string where = source_location(value, file_);
-    const std::string table_name = path_.empty() ? "the top level" : fmt::format("[{}]", path_);
-    throw InputError(fmt::format("{}: {}: unknown key; allowed in {}: {}", where, dotted(key.str()),
-                                 table_name, allowed_keys));
+  if (!n->is_table()) {
+    const std::string what = n->is_array() || n->is_date() || n->is_time() || n->is_date_time()
+                                 ? type_name(*n)
+                                 : fmt::format("{} is {}", describe(*n), type_name(*n));
+    fail_at(key, fmt::format("{}, not a table; allowed: {}", what, description));
   }
+  return TableReader(*n->as_table(), dotted(key), file_, locations_, source_location(*n, file_),
+                     true);
 }
 
 void apply_overrides(toml::table& document, const std::vector<std::string>& overrides) {
   for (const std::string& text : overrides) {
+    const std::string option = fmt::format("{}{}", override_prefix, printable(text));
+    const std::string where = fmt::format("command line ({})", option);
     const auto equals = text.find('=');
-    const std::string option = fmt::format("{}{}", override_prefix, text);
-    if (equals == std::string::npos || equals == 0) {
-      throw InputError(
-          fmt::format("command line ({}): expected KEY=VALUE, e.g. mill.speed=0.75", option));
+    if (equals == std::string::npos) {
+      throw InputError(fmt::format("{}: no '=' between the key and the value; allowed: {}", where,
+                                   override_allowed));
     }
-    const std::string key = text.substr(0, equals);
-    const std::string value_text = text.substr(equals + 1);
-    toml::table parsed;
-    try {
-      parsed = toml::parse(fmt::format("value = {}", value_text), std::string_view(option));
-    } catch (const toml::parse_error&) {
-      std::string quoted;
-      for (const char c : value_text) {
-        if (c == '"' || c == '\\') quoted += '\\';
-        quoted += c;
-      }
-      try {
-        parsed = toml::parse(fmt::format("value = \"{}\"", quoted), std::string_view(option));
-      } catch (const toml::parse_error& error) {
-        throw InputError(fmt::format("command line ({}): cannot read the value: {}", option,
-                                     error.description()));
-      }
+    const std::string_view key = trim(std::string_view(text).substr(0, equals));
+    if (key.empty()) {
+      throw InputError(fmt::format("{}: no key before '='; allowed: {}", where, override_allowed));
     }
-    // Walk to the parent table, creating tables as needed.
-    toml::table* table = &document;
-    std::size_t start = 0;
-    for (;;) {
+    std::vector<std::string_view> parts;
+    for (std::size_t start = 0;;) {
       const auto dot = key.find('.', start);
-      const std::string part = key.substr(start, dot == std::string::npos ? dot : dot - start);
-      if (part.empty()) {
-        throw InputError(fmt::format("command line ({}): '{}' is not a valid key", option, key));
+      parts.push_back(key.substr(start, dot == std::string_view::npos ? dot : dot - start));
+      if (!valid_key_part(parts.back())) {
+        throw InputError(fmt::format(
+            "{}: {}: '{}' is not a valid key name; allowed: names of letters, digits, _ and - "
+            "joined by dots, e.g. mill.lifters.count",
+            where, printable(key), printable(parts.back())));
       }
-      if (dot == std::string::npos) {
-        parsed.get("value")->visit(
-            [&](auto&& value) { table->insert_or_assign(part, std::move(value)); });
-        break;
-      }
+      if (dot == std::string_view::npos) break;
+      start = dot + 1;
+    }
+    toml::table parsed =
+        parse_override_value(trim(std::string_view(text).substr(equals + 1)), option);
+
+    // Walk to the parent table, creating the missing tables with the option as their source.
+    toml::table* table = &document;
+    for (std::size_t k = 0; k + 1 < parts.size(); ++k) {
+      const std::string part(parts[k]);
       toml::node* next = table->get(part);
       if (next == nullptr) {
-        table->insert(part, toml::table{});
+        toml::table created = parse_override_value("{}", option);
+        toml::node& fresh = *created.get("value");
+        fresh.as_table()->is_inline(false);
+        table->insert(part, std::move(*fresh.as_table()));
         next = table->get(part);
       }
       if (!next->is_table()) {
+        const auto parent_end =
+            static_cast<std::size_t>(parts[k].data() - key.data()) + part.size();
+        const std::string_view parent = key.substr(0, parent_end);
         throw InputError(
-            fmt::format("command line ({}): '{}' is not a table", option, key.substr(0, dot)));
+            fmt::format("{}: {}: cannot set a key inside {}, which is {}, not a table; allowed: {}",
+                        where, key, parent, type_name(*next), override_allowed));
       }
       table = next->as_table();
-      start = dot + 1;
     }
+    parsed.get("value")->visit([&](auto&& value) {
+      table->insert_or_assign(std::string(parts.back()), std::move(value));
+    });
   }
 }
 

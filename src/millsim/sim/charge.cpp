@@ -81,10 +81,11 @@ MillPlan plan_mill(const MillConfig& config) {
   if (config.time_step) {
     if (*config.time_step >= plan.critical_time_step) {
       throw InputError(fmt::format(
-          "{}: simulation.time_step: {:.4g} s is unstable for these materials and balls; it must "
-          "be below the stability limit {:.4g} s (and for accuracy about {:.3g} s, 1/{} of the "
-          "shortest contact), or \"auto\"",
-          config.source, *config.time_step, plan.critical_time_step, accurate, steps_per_contact));
+          "{}: simulation.time_step: {:.4g} s is unstable for these materials and balls (the "
+          "stability limit is {:.4g} s; for accuracy about {:.3g} s, 1/{} of the shortest "
+          "contact); allowed: \"auto\" or a number of seconds below {:.4g}",
+          config.location_of("simulation.time_step"), *config.time_step, plan.critical_time_step,
+          accurate, steps_per_contact, plan.critical_time_step));
     }
     plan.time_step = *config.time_step;
   } else {
@@ -151,7 +152,8 @@ World<2> build_mill_world(const MillPlan& plan) {
         throw InputError(fmt::format(
             "{}: charge.filling: could not place {} discs of {} m without overlap in the mill "
             "(placed {}); lower the filling or use smaller balls",
-            config.source, plan.particle_count, c.diameter, particles.size()));
+            config.location_of("charge.filling"), plan.particle_count, c.diameter,
+            particles.size()));
       }
     }
   }

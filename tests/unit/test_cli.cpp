@@ -1,0 +1,325 @@
+// The millsim program on bad input: each refusal exits with status 2, prints one message on
+// stderr ("millsim: error: FILE:LINE: dotted.key: ...; allowed: ...") and writes nothing. Each
+// test runs the built program in a fresh temporary directory.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// A small complete config; the tests change one line of it at a time.
+constexpr std::string_view base_config = R"([simulation]
+time_step = "auto"
+revolutions = 6
+measure_revolutions = 4
+
+[mill]
+diameter = 0.9
+length = 0.15
+speed = 0.5
+
+[mill.lifters]
+count = 8
+height = 0.04
+width = 0.04
+
+[charge]
+filling = 0.3
+density = 7800
+ball_diameter = 0.0508
+
+[output]
+directory = "out"
+snapshot_interval = 0.05
+)";
+
+// A run short enough for a unit test (a fraction of a second).
+constexpr const char* tiny_run =
+    "--set simulation.revolutions=1 --set simulation.measure_revolutions=1 "
+    "--set simulation.settle_time=0.01 --set output.snapshot_interval=0";
+
+/// The 1-based number of the first line that starts with `start` (0 if none).
+int line_of(std::string_view text, std::string_view start) {
+  int line = 1;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    if (text.substr(at).starts_with(start)) return line;
+    const auto end = text.find('\n', at);
+    if (end == std::string_view::npos) break;
+    at = end + 1;
+    ++line;
+  }
+  return 0;
+}
+
+/// `text` with its first line starting with `start` replaced by `replacement` (empty: removed).
+std::string with(std::string_view text, std::string_view start, std::string_view replacement) {
+  const int line = line_of(text, start);
+  EXPECT_GT(line, 0) << "no line starts with " << start;
+  std::string out;
+  int n = 1;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    auto end = text.find('\n', at);
+    if (end == std::string_view::npos) end = text.size();
+    if (n == line) {
+      if (!replacement.empty()) out += std::string(replacement) + "\n";
+    } else {
+      out += std::string(text.substr(at, end - at)) + "\n";
+    }
+    at = end + 1;
+    ++n;
+  }
+  return out;
+}
+
+/// "mill.toml:LINE" for the line of `text` that starts with `start`.
+std::string at_line(std::string_view text, std::string_view start) {
+  return "mill.toml:" + std::to_string(line_of(text, start));
+}
+
+std::string quoted(const std::string& text) {
+  std::string out = "'";
+  for (const char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string read_all(const fs::path& path) {
+  std::ifstream file(path);
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+struct Outcome {
+  int status = -1;
+  std::string out;
+  std::string err;
+};
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "millsim-cli-XXXXXX").string();
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+    root_ = pattern;
+    work_ = root_ / "work";
+    fs::create_directory(work_);
+  }
+  void TearDown() override {
+    std::error_code ignored;
+    fs::remove_all(root_, ignored);
+  }
+
+  /// Writes the config `mill.toml` in the working directory.
+  void write_config(std::string_view text) const { std::ofstream(work_ / "mill.toml") << text; }
+
+  /// Runs `millsim ARGS` in the working directory; ARGS is shell text.
+  Outcome millsim(const std::string& args) const {
+    const std::string command = "cd " + quoted(work_.string()) + " && " + quoted(MILLSIM_BINARY) +
+                                " " + args + " >" + quoted((root_ / "stdout").string()) + " 2>" +
+                                quoted((root_ / "stderr").string()) + " </dev/null";
+    const int raw = std::system(command.c_str());
+    Outcome o;
+    o.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    o.out = read_all(root_ / "stdout");
+    o.err = read_all(root_ / "stderr");
+    return o;
+  }
+
+  /// Runs `millsim run mill.toml -o out -q EXTRA` on `text`.
+  Outcome run_config(std::string_view text, const std::string& extra = {}) const {
+    write_config(text);
+    return millsim("run mill.toml -o out -q " + extra);
+  }
+
+  /// The run was refused as bad input: status 2, one "millsim: error:" message holding every
+  /// part, and nothing written next to the config.
+  void expect_refused(const Outcome& o, std::initializer_list<std::string_view> parts) const {
+    EXPECT_EQ(o.status, 2) << o.err;
+    EXPECT_TRUE(o.err.starts_with("millsim: error: ")) << o.err;
+    EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+    for (const std::string_view part : parts) {
+      EXPECT_NE(o.err.find(part), std::string::npos)
+          << "message lacks \"" << part << "\":\n  " << o.err;
+    }
+    EXPECT_FALSE(fs::exists(work_ / "out")) << "the output directory was created";
+    for (const auto& entry : fs::directory_iterator(work_)) {
+      EXPECT_EQ(entry.path().filename(), "mill.toml") << "written: " << entry.path();
+    }
+  }
+
+  fs::path root_;
+  fs::path work_;
+};
+
+TEST_F(Cli, ATinyRunOfTheBaseConfigWritesItsResults) {
+  // The control for every "nothing written" check below.
+  const Outcome o = run_config(base_config, tiny_run);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_TRUE(fs::exists(work_ / "out" / "summary.json"));
+  EXPECT_NE(o.out.find("power"), std::string::npos) << o.out;
+}
+
+TEST_F(Cli, RefusesATimeStepAboveTheStabilityLimitAndGivesTheLimit) {
+  const std::string text = with(base_config, "time_step", "time_step = 0.01");
+  const Outcome o = run_config(text, tiny_run);
+  expect_refused(o, {at_line(text, "time_step"), "simulation.time_step", "0.01 s is unstable",
+                     "stability limit is 0.00", "\"auto\""});
+  // The same from the command line.
+  expect_refused(run_config(base_config, "--set simulation.time_step=0.01"),
+                 {"command line (--set simulation.time_step=0.01)", "simulation.time_step",
+                  "stability limit is 0.00"});
+}
+
+TEST_F(Cli, RefusesATomlSyntaxErrorWithFileAndLine) {
+  const std::string text = with(base_config, "length", "length = 0.15 0.2");
+  expect_refused(run_config(text), {at_line(text, "length"), "not valid TOML", "allowed: TOML"});
+}
+
+TEST_F(Cli, RefusesAnUnknownKey) {
+  const std::string text = with(base_config, "length", "length = 0.15\ncolour = \"red\"");
+  expect_refused(run_config(text), {at_line(text, "colour"), "mill.colour: unknown key",
+                                    "allowed in [mill]: diameter, length, speed"});
+}
+
+TEST_F(Cli, RefusesAnUnknownTable) {
+  const std::string text = with(base_config, "[output]", "[outptu]");
+  expect_refused(run_config(text), {at_line(text, "[outptu]"), "outptu: unknown table",
+                                    "did you mean output?", "allowed at the top level"});
+}
+
+TEST_F(Cli, RefusesAMisspeltKeyInANestedTable) {
+  const std::string text = with(base_config, "height", "hieght = 0.04");
+  expect_refused(run_config(text), {at_line(text, "hieght"), "mill.lifters.hieght: unknown key",
+                                    "did you mean height?", "count, height, width"});
+}
+
+TEST_F(Cli, RefusesAWrongType) {
+  const std::string text = with(base_config, "diameter", "diameter = \"0.9\"");
+  expect_refused(run_config(text), {at_line(text, "diameter"), "mill.diameter",
+                                    "\"0.9\" is a string", "allowed: a number of metres > 0"});
+}
+
+TEST_F(Cli, RefusesAMissingRequiredKey) {
+  const std::string text = with(base_config, "length", "");
+  expect_refused(run_config(text), {at_line(text, "[mill]"), "mill.length", "missing required key",
+                                    "allowed: a number of metres"});
+}
+
+TEST_F(Cli, RefusesANegativeDiameter) {
+  const std::string text = with(base_config, "diameter", "diameter = -0.9");
+  expect_refused(run_config(text), {at_line(text, "diameter"), "mill.diameter",
+                                    "-0.9 is not allowed", "allowed: a number of metres > 0"});
+}
+
+TEST_F(Cli, RefusesAFillingOfOneOrMore) {
+  for (const char* filling : {"filling = 1", "filling = 1.2"}) {
+    const std::string text = with(base_config, "filling", filling);
+    expect_refused(run_config(text), {at_line(text, "filling"), "charge.filling", "is not allowed",
+                                      "allowed: a fraction", "< 1"});
+  }
+}
+
+TEST_F(Cli, RefusesLiftersThatOverlap) {
+  const std::string text = with(base_config, "width", "width = 0.33");
+  expect_refused(run_config(text),
+                 {at_line(text, "width"), "mill.lifters.width", "0.33 is not allowed", "overlap"});
+}
+
+TEST_F(Cli, RefusesLiftersThatFillTheMill) {
+  const std::string text = with(base_config, "height", "height = 0.5");
+  expect_refused(run_config(text), {at_line(text, "height"), "mill.lifters.height",
+                                    "0.5 is not allowed", "< 0.45", "fill the mill"});
+}
+
+TEST_F(Cli, RefusesBothSpeeds) {
+  const std::string text = with(base_config, "speed", "speed = 0.5\nspeed_rpm = 20");
+  expect_refused(run_config(text), {at_line(text, "speed_rpm"), "mill.speed_rpm",
+                                    "given as well as mill.speed", "not both"});
+}
+
+TEST_F(Cli, RefusesNoSpeed) {
+  const std::string text = with(base_config, "speed", "");
+  expect_refused(run_config(text), {at_line(text, "[mill]"), "mill.speed", "missing required key",
+                                    "allowed: either mill.speed"});
+}
+
+TEST_F(Cli, RefusesMassFractionsThatDoNotSumToOne) {
+  const std::string text = with(base_config, "ball_diameter",
+                                "sizes = [{ diameter = 0.05, mass_fraction = 0.7 },\n"
+                                "         { diameter = 0.04, mass_fraction = 0.4 }]");
+  expect_refused(run_config(text), {at_line(text, "sizes"), "charge.sizes", "sum to 1.1",
+                                    "allowed: mass fractions that sum to 1"});
+}
+
+TEST_F(Cli, RefusesThreeDimensionsClearly) {
+  const std::string text = with(base_config, "time_step", "dimension = 3\ntime_step = \"auto\"");
+  expect_refused(run_config(text), {at_line(text, "dimension"), "simulation.dimension",
+                                    "not available yet", "allowed: 2"});
+}
+
+TEST_F(Cli, RefusesANamedTimeStepOtherThanAuto) {
+  const std::string text = with(base_config, "time_step", "time_step = \"fast\"");
+  expect_refused(run_config(text), {at_line(text, "time_step"), "simulation.time_step",
+                                    "\"fast\" is not allowed", "allowed: \"auto\""});
+}
+
+TEST_F(Cli, AcceptsAnIntegerForANumberAndRefusesAFractionForAnInteger) {
+  write_config(with(base_config, "density", "density = 7800"));
+  const Outcome ok = millsim("info mill.toml");
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_NE(ok.out.find("density 7800 kg/m3"), std::string::npos) << ok.out;
+
+  const std::string text = with(base_config, "count", "count = 8.5");
+  expect_refused(run_config(text), {at_line(text, "count"), "mill.lifters.count",
+                                    "8.5 is not a whole number", "allowed: a whole number"});
+}
+
+TEST_F(Cli, AValidOverrideChangesTheValue) {
+  write_config(base_config);
+  const Outcome before = millsim("info mill.toml");
+  const Outcome after = millsim("info mill.toml --set mill.speed=0.6");
+  ASSERT_EQ(before.status, 0) << before.err;
+  ASSERT_EQ(after.status, 0) << after.err;
+  EXPECT_NE(before.out.find("= 50.0% of critical"), std::string::npos) << before.out;
+  EXPECT_NE(after.out.find("= 60.0% of critical"), std::string::npos) << after.out;
+}
+
+TEST_F(Cli, RefusesAnOverrideOfAnUnknownKeyNamingTheOption) {
+  expect_refused(run_config(base_config, "--set mill.lifters.hieght=0.04"),
+                 {"command line (--set mill.lifters.hieght=0.04)", "mill.lifters.hieght",
+                  "unknown key", "did you mean height?", "allowed in [mill.lifters]"});
+}
+
+TEST_F(Cli, RefusesAnOverrideWithABadValueNamingTheOption) {
+  expect_refused(run_config(base_config, "--set charge.filling=1"),
+                 {"command line (--set charge.filling=1)", "charge.filling", "1 is not allowed",
+                  "allowed: a fraction"});
+}
+
+TEST_F(Cli, RefusesAMalformedOverride) {
+  expect_refused(run_config(base_config, "--set mill.speed"),
+                 {"command line (--set mill.speed)", "no '='", "allowed: KEY=VALUE"});
+}
+
+TEST_F(Cli, RefusesAMissingConfigFile) {
+  const Outcome o = millsim("run no-such-mill.toml -o out -q");
+  EXPECT_EQ(o.status, 2) << o.err;
+  EXPECT_TRUE(o.err.starts_with("millsim: error: no-such-mill.toml: no such config file")) << o.err;
+  EXPECT_NE(o.err.find("allowed: the path of a mill config file"), std::string::npos) << o.err;
+  EXPECT_TRUE(fs::is_empty(work_));
+}
+
+}  // namespace

@@ -1,0 +1,396 @@
+// Reading a mill config (config.hpp): good input gives the values written, bad input is refused
+// with a message that names the file, the line, the dotted key and what is allowed.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "millsim/core/error.hpp"
+#include "millsim/io/config.hpp"
+
+namespace millsim {
+namespace {
+
+// A small complete config; the tests change one line of it at a time.
+constexpr std::string_view base_config = R"([simulation]
+time_step = "auto"
+revolutions = 6
+measure_revolutions = 4
+
+[mill]
+diameter = 0.9
+length = 0.15
+speed = 0.5
+
+[mill.lifters]
+count = 8
+height = 0.04
+width = 0.04
+
+[charge]
+filling = 0.3
+density = 7800
+ball_diameter = 0.0508
+
+[output]
+directory = "out"
+snapshot_interval = 0.05
+)";
+
+constexpr const char* file_name = "mill.toml";
+
+/// The 1-based number of the first line that starts with `start` (0 if none).
+int line_of(std::string_view text, std::string_view start) {
+  int line = 1;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    if (text.substr(at).starts_with(start)) return line;
+    const auto end = text.find('\n', at);
+    if (end == std::string_view::npos) break;
+    at = end + 1;
+    ++line;
+  }
+  return 0;
+}
+
+/// `text` with its first line starting with `start` replaced by `replacement` (which may hold
+/// several lines, or be empty to remove the line).
+std::string with(std::string_view text, std::string_view start, std::string_view replacement) {
+  const int line = line_of(text, start);
+  EXPECT_GT(line, 0) << "no line starts with " << start;
+  std::string out;
+  int n = 1;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    auto end = text.find('\n', at);
+    if (end == std::string_view::npos) end = text.size();
+    if (n == line) {
+      if (!replacement.empty()) out += std::string(replacement) + "\n";
+    } else {
+      out += std::string(text.substr(at, end - at)) + "\n";
+    }
+    at = end + 1;
+    ++n;
+  }
+  return out;
+}
+
+/// "mill.toml:LINE" for the line of `text` that starts with `start`.
+std::string at_line(std::string_view text, std::string_view start) {
+  return std::string(file_name) + ":" + std::to_string(line_of(text, start));
+}
+
+/// The message of the InputError that reading `text` throws; a test failure if none.
+std::string error_of(std::string_view text, const std::vector<std::string>& overrides = {}) {
+  try {
+    parse_mill_config(text, file_name, overrides);
+  } catch (const InputError& error) {
+    return error.what();
+  } catch (const std::exception& error) {
+    ADD_FAILURE() << "not an InputError: " << error.what();
+    return {};
+  }
+  ADD_FAILURE() << "accepted:\n" << text;
+  return {};
+}
+
+void expect_has(const std::string& message, std::initializer_list<std::string_view> parts) {
+  for (const std::string_view part : parts) {
+    EXPECT_NE(message.find(part), std::string::npos)
+        << "message lacks \"" << part << "\":\n  " << message;
+  }
+}
+
+TEST(Config, ReadsTheBaseConfig) {
+  const MillConfig c = parse_mill_config(base_config, file_name);
+  EXPECT_EQ(c.source, file_name);
+  EXPECT_EQ(c.dimension, 2);
+  EXPECT_FALSE(c.time_step.has_value());
+  EXPECT_DOUBLE_EQ(c.diameter, 0.9);
+  EXPECT_DOUBLE_EQ(c.length, 0.15);
+  ASSERT_TRUE(c.speed_fraction.has_value());
+  EXPECT_DOUBLE_EQ(*c.speed_fraction, 0.5);
+  EXPECT_FALSE(c.speed_rpm.has_value());
+  EXPECT_EQ(c.lifter_count, 8);
+  EXPECT_DOUBLE_EQ(c.lifter_height, 0.04);
+  EXPECT_DOUBLE_EQ(c.filling, 0.3);
+  ASSERT_EQ(c.sizes.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.sizes[0].diameter, 0.0508);
+  EXPECT_DOUBLE_EQ(c.sizes[0].mass_fraction, 1.0);
+  EXPECT_EQ(c.output_directory, "out");
+  EXPECT_EQ(c.measure_revolutions, 4);
+}
+
+TEST(Config, ReadsTheShippedExample) {
+  const std::string path = std::string(MILLSIM_SOURCE_DIR) + "/examples/lab-mill-2d.toml";
+  const MillConfig c = load_mill_config(path);
+  EXPECT_EQ(c.source, path);
+  EXPECT_GT(c.diameter, 0.0);
+  EXPECT_FALSE(c.sizes.empty());
+}
+
+TEST(Config, AcceptsAnIntegerWhereANumberIsExpected) {
+  // density = 7800 is a TOML integer.
+  const MillConfig c = parse_mill_config(with(base_config, "diameter", "diameter = 1"), file_name);
+  EXPECT_DOUBLE_EQ(c.density, 7800.0);
+  EXPECT_DOUBLE_EQ(c.diameter, 1.0);
+}
+
+TEST(Config, AcceptsAWholeFloatWhereAnIntegerIsExpected) {
+  const MillConfig c = parse_mill_config(with(base_config, "count", "count = 8.0"), file_name);
+  EXPECT_EQ(c.lifter_count, 8);
+}
+
+TEST(Config, RefusesAFractionWhereAnIntegerIsRequired) {
+  const std::string text = with(base_config, "count", "count = 8.5");
+  expect_has(error_of(text), {at_line(text, "count"), "mill.lifters.count", "8.5",
+                              "not a whole number", "allowed: a whole number from 0 to 360"});
+}
+
+TEST(Config, RefusesATomlSyntaxErrorWithFileAndLine) {
+  const std::string text = with(base_config, "length", "length = 0.15 0.2");
+  expect_has(error_of(text), {at_line(text, "length"), "not valid TOML", "allowed: TOML"});
+  const std::string unclosed = with(base_config, "[charge]", "[charge");
+  expect_has(error_of(unclosed), {at_line(unclosed, "[charge"), "not valid TOML"});
+}
+
+TEST(Config, RefusesAnUnknownTable) {
+  const std::string text = with(base_config, "[output]", "[outptu]");
+  expect_has(error_of(text), {at_line(text, "[outptu]"), "outptu: unknown table",
+                              "did you mean output?", "allowed at the top level", "simulation"});
+}
+
+TEST(Config, RefusesAnUnknownKeyAndSaysWhereItBelongs) {
+  const std::string text = with(base_config, "length", "length = 0.15\nfilling = 0.3");
+  // The first line starting "filling" is the one in [mill].
+  expect_has(error_of(text), {at_line(text, "filling"), "mill.filling: unknown key",
+                              "it belongs in [charge]", "allowed in [mill]: diameter, length"});
+}
+
+TEST(Config, RefusesAMisspeltKeyInANestedTableAsMisspelt) {
+  // Not "height: missing required key": the misspelt key is the problem.
+  const std::string text = with(base_config, "height", "hieght = 0.04");
+  expect_has(error_of(text),
+             {at_line(text, "hieght"), "mill.lifters.hieght: unknown key", "did you mean height?",
+              "allowed in [mill.lifters]: count, height, width"});
+}
+
+TEST(Config, RefusesAValueOfTheWrongType) {
+  const std::string text = with(base_config, "diameter", "diameter = \"0.9\"");
+  expect_has(error_of(text), {at_line(text, "diameter"), "mill.diameter", "\"0.9\" is a string",
+                              "allowed: a number of metres > 0"});
+  const std::string table = with(base_config, "snapshot_interval", "snapshot_interval = [1]");
+  expect_has(error_of(table), {"output.snapshot_interval", "an array", "allowed: a number"});
+}
+
+TEST(Config, RefusesAMissingRequiredKeyAtTheStartOfItsTable) {
+  const std::string text = with(base_config, "length", "");
+  expect_has(error_of(text), {at_line(text, "[mill]"), "mill.length", "missing required key",
+                              "[mill]", "allowed: a number of metres > 0"});
+}
+
+TEST(Config, RefusesAMissingRequiredTable) {
+  std::string text(base_config.substr(0, base_config.find("[charge]")));
+  expect_has(error_of(text), {"mill.toml: charge: missing required table [charge]",
+                              "allowed: a table [charge]", "filling"});
+}
+
+TEST(Config, NamesTheFileForAKeyMissingFromATableOnlyAnOverrideWrote) {
+  // [charge] is not in the file: --set charge.filling creates it, and ball_diameter is missing.
+  std::string text(base_config.substr(0, base_config.find("[charge]")));
+  expect_has(
+      error_of(text, {"charge.filling=0.3"}),
+      {"mill.toml: charge.ball_diameter: missing required key", "[charge] is not in the file",
+       "--set charge.filling=0.3", "allowed: one of ball_diameter"});
+}
+
+TEST(Config, PointsAtADottedKeyForAKeyMissingFromTheTableItMade) {
+  const std::string text = with(
+      with(with(with(base_config, "[mill.lifters]", ""), "count", ""), "height", ""), "width", "");
+  const std::string dotted = with(text, "speed", "speed = 0.5\nlifters.count = 8");
+  expect_has(error_of(dotted), {at_line(dotted, "lifters.count"), "mill.lifters.height",
+                                "missing required key", "needed because count = 8"});
+}
+
+TEST(Config, RefusesALifterShapeWithoutACount) {
+  const std::string text = with(base_config, "count", "");
+  expect_has(error_of(text), {at_line(text, "[mill.lifters]"), "mill.lifters.count",
+                              "missing required key", "needed when height or width is given"});
+  // count = 0 (a smooth shell, e.g. from --set) keeps the shape unused.
+  const MillConfig smooth = parse_mill_config(base_config, file_name, {"mill.lifters.count=0"});
+  EXPECT_EQ(smooth.lifter_count, 0);
+}
+
+TEST(Config, RefusesImpossibleValues) {
+  const std::string negative = with(base_config, "diameter", "diameter = -0.9");
+  expect_has(error_of(negative), {at_line(negative, "diameter"), "mill.diameter",
+                                  "-0.9 is not allowed", "allowed: a number of metres > 0"});
+  for (const char* filling : {"filling = 1", "filling = 1.5", "filling = 0"}) {
+    const std::string text = with(base_config, "filling", filling);
+    expect_has(error_of(text), {at_line(text, "filling"), "charge.filling", "is not allowed",
+                                "allowed: a fraction of the mill volume > 0 and < 1"});
+  }
+  const std::string porosity = with(base_config, "density", "density = 7800\nporosity = 1");
+  expect_has(error_of(porosity), {at_line(porosity, "porosity"), "charge.porosity", "< 1"});
+  const std::string nan = with(base_config, "length", "length = nan");
+  expect_has(error_of(nan), {at_line(nan, "length"), "mill.length", "nan is not allowed"});
+}
+
+TEST(Config, RefusesLiftersThatFillTheMill) {
+  const std::string text = with(base_config, "height", "height = 0.45");
+  expect_has(error_of(text), {at_line(text, "height"), "mill.lifters.height", "0.45 is not allowed",
+                              "< 0.45 (the mill radius", "fill the mill"});
+}
+
+TEST(Config, RefusesLiftersThatOverlap) {
+  // 8 lifters 4 cm high: the inner circumference 2π (0.45 − 0.04) = 2.576 m gives each 0.322 m.
+  const std::string text = with(base_config, "width", "width = 0.33");
+  expect_has(error_of(text), {at_line(text, "width"), "mill.lifters.width", "0.33 is not allowed",
+                              "< 0.322", "overlap"});
+  EXPECT_EQ(parse_mill_config(with(base_config, "width", "width = 0.32"), file_name).lifter_width,
+            0.32);
+}
+
+TEST(Config, RefusesBothSpeeds) {
+  const std::string text = with(base_config, "speed", "speed = 0.5\nspeed_rpm = 20");
+  expect_has(error_of(text), {at_line(text, "speed_rpm"), "mill.speed_rpm",
+                              "given as well as mill.speed (" + at_line(text, "speed =") + ")",
+                              "allowed: either mill.speed", "not both"});
+}
+
+TEST(Config, RefusesNoSpeed) {
+  const std::string text = with(base_config, "speed", "");
+  expect_has(error_of(text), {at_line(text, "[mill]"), "mill.speed", "missing required key",
+                              "allowed: either mill.speed", "mill.speed_rpm"});
+  const MillConfig rpm = parse_mill_config(with(base_config, "speed", "speed_rpm = 20"), file_name);
+  EXPECT_FALSE(rpm.speed_fraction.has_value());
+  EXPECT_DOUBLE_EQ(rpm.speed_rpm.value_or(0.0), 20.0);
+}
+
+TEST(Config, RefusesMassFractionsThatDoNotSumToOne) {
+  const std::string text = with(base_config, "ball_diameter",
+                                "sizes = [{ diameter = 0.05, mass_fraction = 0.5 },\n"
+                                "         { diameter = 0.04, mass_fraction = 0.4 }]");
+  expect_has(error_of(text), {at_line(text, "sizes"), "charge.sizes", "sum to 0.9",
+                              "allowed: mass fractions that sum to 1"});
+  const std::string good = with(base_config, "ball_diameter",
+                                "sizes = [{ diameter = 0.05, mass_fraction = 0.6 },\n"
+                                "         { diameter = 0.04, mass_fraction = 0.4 }]");
+  EXPECT_EQ(parse_mill_config(good, file_name).sizes.size(), 2u);
+}
+
+TEST(Config, RefusesABadSizeListEntryAtItsLine) {
+  const std::string text = with(base_config, "ball_diameter",
+                                "sizes = [\n  { diameter = 0.05, mass_fraction = 0.5 },\n"
+                                "  { diameter = 0.04, mas_fraction = 0.5 }]");
+  expect_has(error_of(text), {at_line(text, "  { diameter = 0.04"), "charge.sizes[1].mas_fraction",
+                              "unknown key", "did you mean mass_fraction?"});
+  const std::string two =
+      with(base_config, "ball_diameter", "ball_diameter = 0.05\ntop_size = 0.05");
+  expect_has(error_of(two), {at_line(two, "top_size"), "charge.top_size",
+                             "given as well as charge.ball_diameter", "allowed: one of"});
+}
+
+TEST(Config, RefusesThreeDimensionsClearly) {
+  const std::string text = with(base_config, "time_step", "dimension = 3\ntime_step = \"auto\"");
+  expect_has(error_of(text), {at_line(text, "dimension"), "simulation.dimension",
+                              "not available yet", "allowed: 2"});
+  const std::string one = with(base_config, "time_step", "dimension = 1\ntime_step = \"auto\"");
+  expect_has(error_of(one), {at_line(one, "dimension"), "1 is not allowed", "allowed: 2"});
+}
+
+TEST(Config, RefusesATimeStepThatIsNotANumberOrAuto) {
+  const std::string text = with(base_config, "time_step", "time_step = \"fast\"");
+  expect_has(error_of(text),
+             {at_line(text, "time_step"), "simulation.time_step", "\"fast\" is not allowed",
+              "allowed: \"auto\" or a number of seconds"});
+  for (const char* bad : {"time_step = 0", "time_step = -1e-5"}) {
+    const std::string step = with(base_config, "time_step", bad);
+    expect_has(error_of(step), {at_line(step, "time_step"), "simulation.time_step", "> 0"});
+  }
+  const std::string flag = with(base_config, "time_step", "time_step = true");
+  expect_has(error_of(flag), {"simulation.time_step", "true is a boolean", "\"auto\""});
+  const MillConfig fixed =
+      parse_mill_config(with(base_config, "time_step", "time_step = 1e-4"), file_name);
+  EXPECT_DOUBLE_EQ(fixed.time_step.value_or(0.0), 1e-4);
+}
+
+TEST(Config, RefusesMoreMeasuredRevolutionsThanRun) {
+  const std::string text = with(base_config, "revolutions", "revolutions = 2");
+  expect_has(error_of(text),
+             {at_line(text, "measure_revolutions"), "simulation.measure_revolutions",
+              "4 is more than", "simulation.revolutions = 2", "from 1 to 2"});
+  // The default 4 is checked too.
+  const std::string implicit = with(text, "measure_revolutions", "");
+  expect_has(error_of(implicit), {at_line(implicit, "revolutions"),
+                                  "simulation.measure_revolutions", "default 4", "from 1 to 2"});
+  expect_has(error_of(base_config, {"simulation.revolutions=0.5"}),
+             {"command line (--set simulation.revolutions=0.5)", "simulation.revolutions",
+              "allowed: a number of revolutions >= 1"});
+}
+
+TEST(Config, AValidOverrideChangesTheValueAndIsRecordedAsFromTheCommandLine) {
+  const MillConfig c = parse_mill_config(
+      base_config, file_name, {"mill.speed=0.75", "simulation.seed=7", "output.directory=2024"});
+  EXPECT_DOUBLE_EQ(c.speed_fraction.value_or(0.0), 0.75);
+  EXPECT_EQ(c.seed, 7u);
+  EXPECT_EQ(c.output_directory, "2024");  // taken as typed, not as the integer 2024
+  EXPECT_EQ(c.location_of("mill.speed"), "command line (--set mill.speed=0.75)");
+  EXPECT_EQ(c.location_of("mill.diameter"), std::string(file_name) + ":7");
+  EXPECT_EQ(c.location_of("charge.porosity"), file_name);  // a default
+}
+
+TEST(Config, AnOverrideOfAnUnknownKeyNamesTheOption) {
+  expect_has(error_of(base_config, {"mill.lifters.hieght=0.04"}),
+             {"command line (--set mill.lifters.hieght=0.04)", "mill.lifters.hieght", "unknown key",
+              "did you mean height?", "allowed in [mill.lifters]"});
+  expect_has(error_of(base_config, {"mil.speed=0.7"}),
+             {"command line (--set mil.speed=0.7)", "mil: unknown table", "did you mean mill?"});
+}
+
+TEST(Config, AnOverrideWithABadValueNamesTheOption) {
+  expect_has(error_of(base_config, {"mill.diameter=-1"}),
+             {"command line (--set mill.diameter=-1)", "mill.diameter", "-1 is not allowed",
+              "allowed: a number of metres > 0"});
+  expect_has(error_of(base_config, {"mill.speed=fast"}),
+             {"command line (--set mill.speed=fast)", "mill.speed", "\"fast\" is a string",
+              "allowed: a fraction of critical speed"});
+  expect_has(error_of(base_config, {"mill.diameter.inner=1"}),
+             {"command line (--set mill.diameter.inner=1)", "not a table"});
+}
+
+TEST(Config, RefusesAMalformedOverride) {
+  expect_has(error_of(base_config, {"mill.speed"}),
+             {"command line (--set mill.speed)", "no '='", "allowed: KEY=VALUE"});
+  expect_has(error_of(base_config, {"=0.7"}),
+             {"command line (--set =0.7)", "no key", "allowed: KEY=VALUE"});
+  expect_has(error_of(base_config, {"mill..speed=0.7"}),
+             {"command line (--set mill..speed=0.7)", "not a valid key name", "allowed:"});
+}
+
+TEST(Config, RefusesAMissingOrUnreadableFile) {
+  const std::string missing = "no-such-dir/no-such-mill.toml";
+  try {
+    load_mill_config(missing);
+    ADD_FAILURE() << "accepted a missing file";
+  } catch (const InputError& error) {
+    expect_has(error.what(), {missing, "no such config file", "allowed: the path of a mill"});
+  }
+  try {
+    load_mill_config(std::filesystem::temp_directory_path().string());
+    ADD_FAILURE() << "accepted a directory";
+  } catch (const InputError& error) {
+    expect_has(error.what(), {"is a directory", "allowed:"});
+  }
+}
+
+TEST(Config, RefusesAnEmptyFile) {
+  expect_has(error_of(""), {"mill.toml: mill: missing required table [mill]", "allowed:"});
+}
+
+}  // namespace
+}  // namespace millsim
