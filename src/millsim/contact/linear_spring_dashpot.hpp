@@ -20,6 +20,8 @@ class LinearSpringDashpot {
       : normal_stiffness_(material.normal_stiffness),
         tangential_stiffness_(material.tangential_stiffness),
         damping_ratio_(damping_ratio(material.restitution)),
+        sqrt_normal_stiffness_(std::sqrt(material.normal_stiffness)),
+        sqrt_tangential_stiffness_(std::sqrt(material.tangential_stiffness)),
         friction_(material.friction),
         allow_tension_(allow_tension) {}
 
@@ -46,7 +48,7 @@ class LinearSpringDashpot {
 
     // Normal: spring k_n (δ − origin) and dashpot D_n = −c_n v_n, c_n = 2 ζ sqrt(k_n m*).
     const double sqrt_mass = std::sqrt(in.effective_mass);
-    const double normal_damping = 2.0 * damping_ratio_ * std::sqrt(normal_stiffness_) * sqrt_mass;
+    const double normal_damping = 2.0 * damping_ratio_ * sqrt_normal_stiffness_ * sqrt_mass;
     const double normal_spring = normal_stiffness_ * (in.overlap - history.normal_spring_origin);
     const double normal_force = normal_spring - normal_damping * normal_speed;
 
@@ -86,7 +88,7 @@ class LinearSpringDashpot {
       out.tangential_force = spring;
     } else {
       const double tangential_damping =
-          2.0 * damping_ratio_ * std::sqrt(tangential_stiffness_) * sqrt_mass;
+          2.0 * damping_ratio_ * sqrt_tangential_stiffness_ * sqrt_mass;
       out.tangential_force = spring - tangential_damping * sliding_velocity;
       out.dissipated += tangential_damping * norm_squared(sliding_velocity) * time_step;
     }
@@ -100,6 +102,8 @@ class LinearSpringDashpot {
   double normal_stiffness_;
   double tangential_stiffness_;
   double damping_ratio_;
+  double sqrt_normal_stiffness_;
+  double sqrt_tangential_stiffness_;
   double friction_;
   bool allow_tension_;
 };

@@ -12,8 +12,7 @@ namespace {
 /// shell (a > R) is out of reach and only closes the shape. Returns false when not touching.
 bool lifter_contact(const Mill2D& mill, int index, const Vec2& centre, double particle_radius,
                     WallContact<2>& contact) {
-  const double lifter_angle = mill.angle + 2.0 * pi * index / mill.lifter_count;
-  const Vec2 radial{{std::cos(lifter_angle), std::sin(lifter_angle)}};
+  const Vec2 radial = mill.lifter_direction[static_cast<std::size_t>(index)];
   const Vec2 tangential{{-radial[1], radial[0]}};
   const double a = dot(centre, radial);
   const double b = dot(centre, tangential);
@@ -58,6 +57,16 @@ bool lifter_contact(const Mill2D& mill, int index, const Vec2& centre, double pa
 }
 
 }  // namespace
+
+void Mill2D::turn_to(double new_angle) {
+  angle = new_angle;
+  lifter_direction.resize(static_cast<std::size_t>(lifter_count));
+  for (int k = 0; k < lifter_count; ++k) {
+    const double lifter_angle = angle + 2.0 * pi * k / lifter_count;
+    lifter_direction[static_cast<std::size_t>(k)] =
+        Vec2{{std::cos(lifter_angle), std::sin(lifter_angle)}};
+  }
+}
 
 int mill_contacts(const Mill2D& mill, const Vec2& centre, double particle_radius,
                   WallContact<2>* out) {

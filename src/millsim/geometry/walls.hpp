@@ -31,6 +31,12 @@ struct Mill2D {
   double lifter_width = 0.0;   ///< tangential, m
   double angle = 0.0;          ///< shell orientation, rad (lifter 0 sits at this angle)
   double angular_speed = 0.0;  ///< ω, rad/s
+  /// Unit radial vector of each lifter at `angle`; refreshed by turn_to() (sin and cos once a
+  /// step instead of once a contact).
+  std::vector<Vec2> lifter_direction;
+
+  /// Sets the shell orientation and the lifter directions that follow from it.
+  void turn_to(double new_angle);
 };
 
 /// An infinite plane (a line in 2D): the particle side is where (x − point)·normal > 0.

@@ -108,6 +108,7 @@ World<2> build_mill_world(const MillPlan& plan) {
   mill.lifter_count = config.lifter_count;
   mill.lifter_height = config.lifter_height;
   mill.lifter_width = config.lifter_width;
+  mill.turn_to(0.0);
   walls.mill = mill;
   World<2> world(settings, walls);
 

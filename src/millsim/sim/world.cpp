@@ -25,7 +25,9 @@ World<D>::World(const WorldSettings<D>& settings, const Walls<D>& walls)
       walls_(walls),
       ball_ball_law_(settings.ball_ball, settings.allow_tension),
       ball_wall_law_(settings.ball_wall, settings.allow_tension),
-      neighbours_(settings.skin) {}
+      neighbours_(settings.skin) {
+  if (walls_.mill) walls_.mill->turn_to(walls_.mill->angle);
+}
 
 template <int D>
 void World<D>::step() {
@@ -50,7 +52,7 @@ void World<D>::refresh_neighbours() {
   if (!neighbours_.needs_refresh(particles_.position)) return;
   if (settings_.skin <= 0.0 && count > 0) {
     const double smallest = *std::min_element(particles_.radius.begin(), particles_.radius.end());
-    settings_.skin = 0.5 * smallest;
+    settings_.skin = smallest;
     neighbours_ = NeighbourList<D>(settings_.skin);
   }
   neighbours_.rebuild(particles_.position, particles_.radius);
@@ -218,7 +220,9 @@ void World<D>::integrate() {
 
 template <int D>
 void World<D>::advance_walls() {
-  if (walls_.mill) walls_.mill->angle += walls_.mill->angular_speed * settings_.time_step;
+  if (walls_.mill) {
+    walls_.mill->turn_to(walls_.mill->angle + walls_.mill->angular_speed * settings_.time_step);
+  }
 }
 
 template <int D>

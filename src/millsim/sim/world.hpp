@@ -22,7 +22,7 @@ struct WorldSettings {
   ContactMaterial ball_ball;
   ContactMaterial ball_wall;
   bool allow_tension = false;  ///< see LinearSpringDashpot; false is the model of MODEL.md
-  double skin = 0.0;           ///< neighbour-list skin, m; 0 picks half the smallest radius
+  double skin = 0.0;           ///< neighbour-list skin, m; 0 picks the smallest radius
 };
 
 /// Energy accounts since the world was made, J. The balance
