@@ -30,7 +30,11 @@ ImpactSpectrum::ImpactSpectrum(double lowest_energy, int bins_per_decade, int de
 void ImpactSpectrum::record(ContactType type, double energy) {
   const double position = std::log10(std::max(energy, lowest_energy_) / lowest_energy_);
   const auto last = static_cast<long>(bin_count()) - 1;
-  const long bin = std::clamp(static_cast<long>(position * bins_per_decade_), 0L, last);
+  long bin = std::clamp(static_cast<long>(position * bins_per_decade_), 0L, last);
+  // The logarithm can round an energy sitting exactly on an edge to either side: settle it
+  // against the edges as reported, so that a bin holds [lower edge, upper edge).
+  if (bin < last && energy >= bin_lower_edge(static_cast<std::size_t>(bin + 1))) ++bin;
+  if (bin > 0 && energy < bin_lower_edge(static_cast<std::size_t>(bin))) --bin;
   const auto t = static_cast<std::size_t>(type);
   ++counts_[t][static_cast<std::size_t>(bin)];
   energies_[t][static_cast<std::size_t>(bin)] += energy;
@@ -38,11 +42,14 @@ void ImpactSpectrum::record(ContactType type, double energy) {
 
 double ImpactSpectrum::bin_lower_edge(std::size_t bin) const {
   if (bin == 0) return 0.0;
-  return lowest_energy_ * std::pow(10.0, static_cast<double>(bin) / bins_per_decade_);
+  // From the exponent, so that decade edges of a decimal lowest energy come out exact (1e-7 J,
+  // not 1e-10 × 10^3 = 1.0000000000000001e-7 J).
+  return std::pow(10.0, std::log10(lowest_energy_) + static_cast<double>(bin) / bins_per_decade_);
 }
 
 double ImpactSpectrum::bin_upper_edge(std::size_t bin) const {
-  return lowest_energy_ * std::pow(10.0, static_cast<double>(bin + 1) / bins_per_decade_);
+  return std::pow(10.0,
+                  std::log10(lowest_energy_) + static_cast<double>(bin + 1) / bins_per_decade_);
 }
 
 long ImpactSpectrum::total_count(ContactType type) const {

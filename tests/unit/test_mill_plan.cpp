@@ -1,0 +1,242 @@
+// What plan_mill derives from a mill config (speeds, disc counts, masses, time step) and how
+// build_mill_world places the charge (sim/charge.hpp), each number worked out by hand in the
+// comment above its check. The mill is the built-in example: D = 0.9 m, L = 0.15 m, J = 0.30,
+// 5.08 cm steel balls (ρ = 7800 kg/m³, porosity 0.4), half critical speed, eight 4 × 4 cm lifters,
+// k_n = 4e5 N/m, k_s = 3e5 N/m, e = 0.6 for ball–ball and ball–wall.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "millsim/builtin_example.hpp"
+#include "millsim/core/constants.hpp"
+#include "millsim/core/error.hpp"
+#include "millsim/geometry/walls.hpp"
+#include "millsim/io/config.hpp"
+#include "millsim/particles/material.hpp"
+#include "millsim/sim/charge.hpp"
+
+namespace millsim {
+namespace {
+
+// Relative tolerance for values worked by hand to 8 significant figures.
+constexpr double hand_tolerance = 1e-7;
+
+#define EXPECT_HAND(actual, hand) EXPECT_NEAR((actual), (hand), std::abs(hand) * hand_tolerance)
+
+MillConfig lab_mill(std::vector<std::string> overrides = {}) {
+  overrides.push_back("output.snapshot_interval=0");
+  return parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", overrides);
+}
+
+/// The lab mill with a graded charge of top size 5.08 cm instead of one size.
+MillConfig graded_lab_mill() {
+  MillConfig config = lab_mill();
+  config.sizes = graded_charge(0.0508);
+  return config;
+}
+
+TEST(MillPlan, CriticalSpeedAndSpeedFromAFractionOfIt) {
+  const MillPlan plan = plan_mill(lab_mill());
+  EXPECT_HAND(plan.radius, 0.45);
+  EXPECT_HAND(plan.largest_ball, 0.0508);
+  // N_c = (60/2π) sqrt(2g/(D − d_max)): D − d = 0.9 − 0.0508 = 0.8492 m,
+  // 2g/(D − d) = 19.62 / 0.8492 = 23.104098 s⁻², sqrt = 4.8066722 s⁻¹,
+  // × 60/(2π) = × 9.5492966: N_c = 45.900339 rpm (the rule of thumb 42.3/sqrt(0.8492) = 45.90).
+  EXPECT_HAND(plan.critical_speed_rpm, 45.900339);
+  // speed = 0.5: N = 22.950169 rpm, ω = N × 2π/60 = 2.4033361 rad/s, T = 60/N = 2.6143598 s.
+  EXPECT_HAND(plan.speed_fraction, 0.5);
+  EXPECT_HAND(plan.speed_rpm, 22.950169);
+  EXPECT_HAND(plan.angular_speed, 2.4033361);
+  EXPECT_HAND(plan.revolution_period, 2.6143598);
+  // Total time = settle 1 s + 6 revolutions × 2.6143598 s = 16.686159 s.
+  EXPECT_HAND(plan.total_time, 16.686159);
+}
+
+TEST(MillPlan, SpeedGivenInRpm) {
+  MillConfig config = lab_mill();
+  config.speed_fraction.reset();
+  config.speed_rpm = 30.0;
+  const MillPlan plan = plan_mill(config);
+  // 30 rpm of N_c = 45.900339 rpm is 0.65358995 of critical; ω = 30 × 2π/60 = π rad/s; T = 2 s.
+  EXPECT_HAND(plan.speed_rpm, 30.0);
+  EXPECT_HAND(plan.critical_speed_rpm, 45.900339);
+  EXPECT_HAND(plan.speed_fraction, 0.65358995);
+  EXPECT_HAND(plan.angular_speed, 3.1415927);
+  EXPECT_HAND(plan.revolution_period, 2.0);
+}
+
+TEST(MillPlan, DiscCountMassesAndPowerScaleOfOneSize) {
+  const MillPlan plan = plan_mill(lab_mill());
+  // Disc area = J π R² (1 − 0.2) = 0.3 × 0.63617251 × 0.8 = 0.15268140 m²; one disc
+  // π d²/4 = 0.78539816 × 0.00258064 = 0.0020268299 m²; 0.15268140 / 0.0020268299 = 75.33 -> 75.
+  ASSERT_EQ(plan.discs.size(), 1u);
+  EXPECT_EQ(plan.discs[0].count, 75);
+  EXPECT_EQ(plan.particle_count, 75);
+  EXPECT_HAND(plan.discs[0].diameter, 0.0508);
+  // Each disc has the mass of its sphere: ρ π d³/6 = 7800 × 0.52359878 × 1.31096512e-4
+  // = 0.53540739 kg; the slice holds 75 × 0.53540739 = 40.155554 kg.
+  EXPECT_HAND(plan.discs[0].mass, 0.53540739);
+  EXPECT_HAND(plan.slice_mass, 40.155554);
+  // Mill charge ρ (1 − porosity) J π R² L = 7800 × 0.6 × 0.3 × 0.63617251 × 0.15 = 133.97793 kg;
+  // power_scale = 133.97793 / 40.155554 = 3.3364732.
+  EXPECT_HAND(plan.mill_charge_mass, 133.97793);
+  EXPECT_HAND(plan.power_scale, 3.3364732);
+}
+
+TEST(MillPlan, GradedChargeFollowsBondInFourClasses) {
+  // Bond: mass fraction below d is (d/top)^3.84; classes at top × 0.8^k, k = 0..3.
+  // 0.8^3.84 = exp(3.84 × ln 0.8) = exp(3.84 × −0.22314355) = exp(−0.85687124) = 0.42448813,
+  // 0.8^7.68 = 0.42448813² = 0.18019017, 0.8^11.52 = 0.42448813³ = 0.076488589. Fractions:
+  // 1 − 0.42448813 = 0.57551187, 0.42448813 − 0.18019017 = 0.24429796,
+  // 0.18019017 − 0.076488589 = 0.10370158, and the rest 0.076488589 (docs/model.md: 0.576,
+  // 0.244, 0.104, 0.077).
+  const std::vector<SizeClass> sizes = graded_charge(0.0508);
+  ASSERT_EQ(sizes.size(), 4u);
+  const double diameters[] = {0.0508, 0.04064, 0.032512, 0.0260096};  // 0.0508 × 0.8^k
+  const double fractions[] = {0.57551187, 0.24429796, 0.10370158, 0.076488589};
+  double total = 0.0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_HAND(sizes[k].diameter, diameters[k]);
+    EXPECT_HAND(sizes[k].mass_fraction, fractions[k]);
+    total += sizes[k].mass_fraction;
+  }
+  EXPECT_NEAR(total, 1.0, 1e-12);
+  // The same shape at any top size.
+  const std::vector<SizeClass> small = graded_charge(0.02);
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_HAND(small[k].diameter, 0.02 * std::pow(0.8, static_cast<double>(k)));
+    EXPECT_DOUBLE_EQ(small[k].mass_fraction, sizes[k].mass_fraction);
+  }
+}
+
+TEST(MillPlan, DiscCountsOfAGradedCharge) {
+  const MillPlan plan = plan_mill(graded_lab_mill());
+  // count_k = round(f_k × 0.15268140 m² / (π d_k²/4)):
+  //   5.08 cm: 0.57551187 × 0.15268140 / 0.0020268299 = 43.35 -> 43
+  //   4.064 cm: 0.24429796 × 0.15268140 / 0.0012971711 = 28.75 -> 29
+  //   3.2512 cm: 0.10370158 × 0.15268140 / 0.00083018953 = 19.07 -> 19
+  //   2.60096 cm: 0.076488589 × 0.15268140 / 0.00053132130 = 21.98 -> 22
+  // Masses ρ π d³/6 = 4084.0704 d³: 0.53540739, 0.27412858, 0.14035384, 0.071861164 kg.
+  ASSERT_EQ(plan.discs.size(), 4u);
+  const double diameters[] = {0.0508, 0.04064, 0.032512, 0.0260096};
+  const int counts[] = {43, 29, 19, 22};
+  const double masses[] = {0.53540739, 0.27412858, 0.14035384, 0.071861164};
+  double slice_mass = 0.0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_HAND(plan.discs[k].diameter, diameters[k]);
+    EXPECT_EQ(plan.discs[k].count, counts[k]) << "class " << k;
+    EXPECT_HAND(plan.discs[k].mass, masses[k]);
+    slice_mass += counts[k] * masses[k];
+  }
+  EXPECT_EQ(plan.particle_count, 43 + 29 + 19 + 22);
+  // 43 × 0.53540739 + 29 × 0.27412858 + 19 × 0.14035384 + 22 × 0.071861164
+  // = 23.022518 + 7.9497289 + 2.6667229 + 1.5809456 = 35.219915 kg; power_scale
+  // = 133.97793 / 35.219915 = 3.8040390.
+  EXPECT_HAND(slice_mass, 35.219915);
+  EXPECT_HAND(plan.slice_mass, 35.219915);
+  EXPECT_HAND(plan.power_scale, 3.8040390);
+}
+
+TEST(MillPlan, AutoTimeStepIsATwentiethOfTheShortestContact) {
+  // For a linear spring–dashpot with Corkum's damping, ζ² = ln²e / (ln²e + π²), so
+  // t_c = π / (ω₀ sqrt(1 − ζ²)) = sqrt(m*/k_n) sqrt(π² + ln²e).
+  // e = 0.6: ln e = −0.51082562, π² + ln²e = 9.8696044 + 0.26094282 = 10.130547, root 3.1828521.
+  // Two 5.08 cm discs: m* = 0.53540739 / 2 = 0.26770370 kg, sqrt(m*/k_n) = sqrt(6.6925924e-7)
+  // = 8.1808266e-4 s, t_c = 2.6038361e-3 s. One disc on a wall: m* = m, t_c × sqrt 2
+  // = 3.6823803e-3 s. Δt = 2.6038361e-3 / 20 = 1.3019180e-4 s.
+  const MillConfig config = lab_mill();
+  const MillPlan plan = plan_mill(config);
+  EXPECT_HAND(contact_duration(config.ball_ball, 0.26770370), 2.6038361e-3);
+  EXPECT_HAND(contact_duration(config.ball_wall, 0.53540739), 3.6823803e-3);
+  EXPECT_HAND(plan.contact_duration_ball_ball, 2.6038361e-3);
+  EXPECT_HAND(plan.contact_duration_ball_wall, 3.6823803e-3);
+  EXPECT_HAND(plan.time_step, 1.3019180e-4);
+  EXPECT_EQ(plan.time_step,
+            std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall) /
+                steps_per_contact);
+
+  // Graded charge: the smallest disc, 2.60096 cm, 0.071861164 kg: m* = 0.035930582 kg,
+  // sqrt(m*/k_n) = sqrt(8.9826455e-8) = 2.9971062e-4 s, t_c = 9.5393456e-4 s, Δt = 4.7696728e-5 s.
+  const MillPlan graded = plan_mill(graded_lab_mill());
+  EXPECT_HAND(graded.contact_duration_ball_ball, 9.5393456e-4);
+  EXPECT_HAND(graded.time_step, 4.7696728e-5);
+}
+
+TEST(MillPlan, GivenTimeStepIsUsedBelowTheStabilityLimitAndRefusedAboveIt) {
+  // Stability limit 2/ω_max. Two 5.08 cm discs: normal ω = sqrt(k_n/m*) = sqrt(4e5/0.26770370)
+  // = 1222.3704 s⁻¹; tangential, with 1/m_t = 2 (1 + 1/(1/2))/m = 6/m: sqrt(6 k_s/m)
+  // = sqrt(1.8e6/0.53540739) = 1833.5555 s⁻¹ (a wall, m_t = m/3, is slower). Limit
+  // 2/1833.5555 = 1.0907769e-3 s.
+  const MillPlan plan = plan_mill(lab_mill());
+  EXPECT_HAND(plan.critical_time_step, 1.0907769e-3);
+  EXPECT_EQ(plan_mill(lab_mill({"simulation.time_step=1e-3"})).time_step, 1e-3);
+  EXPECT_THROW(plan_mill(lab_mill({"simulation.time_step=1.1e-3"})), InputError);
+}
+
+/// Every disc inside the shell, clear of the lifters and of every other disc.
+void expect_placed_without_contacts(const MillPlan& plan, const World<2>& world) {
+  const auto& p = world.particles();
+  ASSERT_EQ(p.size(), static_cast<std::size_t>(plan.particle_count));
+  const Mill2D& mill = *world.walls().mill;
+  EXPECT_EQ(mill.radius, plan.radius);
+  EXPECT_EQ(mill.lifter_count, 8);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    EXPECT_LT(norm(p.position[i]) + p.radius[i], plan.radius) << "disc " << i << " in the shell";
+    WallContact<2> found[4];
+    EXPECT_EQ(mill_contacts(mill, p.position[i], p.radius[i], found), 0) << "disc " << i;
+    EXPECT_EQ(p.velocity[i], Vec2{}) << "disc " << i << " starts at rest";
+    EXPECT_EQ(p.angular_velocity[i], 0.0);
+    for (std::size_t j = i + 1; j < p.size(); ++j) {
+      EXPECT_GT(norm(p.position[j] - p.position[i]), p.radius[i] + p.radius[j])
+          << "discs " << i << " and " << j << " overlap";
+    }
+  }
+  // Each class is there with its count, radius and mass.
+  for (const DiscClass& c : plan.discs) {
+    const auto count = std::count_if(p.radius.begin(), p.radius.end(),
+                                     [&](double r) { return r == 0.5 * c.diameter; });
+    EXPECT_EQ(count, c.count) << "discs of " << c.diameter << " m";
+  }
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const auto c = std::find_if(plan.discs.begin(), plan.discs.end(), [&](const DiscClass& d) {
+      return 0.5 * d.diameter == p.radius[i];
+    });
+    ASSERT_NE(c, plan.discs.end());
+    EXPECT_EQ(p.mass[i], c->mass);
+  }
+}
+
+TEST(MillPlan, ChargeIsPlacedWithoutTouchingWallsOrEachOther) {
+  const MillPlan plan = plan_mill(lab_mill());
+  const World<2> world = build_mill_world(plan);
+  expect_placed_without_contacts(plan, world);
+  EXPECT_EQ(world.walls().mill->angular_speed, 0.0) << "the shell starts still";
+  EXPECT_EQ(world.settings().time_step, plan.time_step);
+  EXPECT_EQ(world.settings().gravity, (Vec2{{0.0, -9.81}}));
+
+  const MillPlan graded = plan_mill(graded_lab_mill());
+  expect_placed_without_contacts(graded, build_mill_world(graded));
+}
+
+TEST(MillPlan, PlacementIsDecidedByTheSeed) {
+  const MillPlan plan = plan_mill(lab_mill());
+  const World<2> a = build_mill_world(plan);
+  const World<2> b = build_mill_world(plan);
+  EXPECT_EQ(a.particles().position, b.particles().position) << "same seed, same bits";
+  EXPECT_EQ(a.particles().radius, b.particles().radius);
+
+  const MillPlan other = plan_mill(lab_mill({"simulation.seed=2"}));
+  const World<2> c = build_mill_world(other);
+  ASSERT_EQ(c.particles().size(), a.particles().size());
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < a.particles().size(); ++i) {
+    differing += a.particles().position[i] != c.particles().position[i] ? 1 : 0;
+  }
+  EXPECT_EQ(differing, a.particles().size()) << "another seed moves every disc";
+}
+
+}  // namespace
+}  // namespace millsim

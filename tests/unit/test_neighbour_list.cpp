@@ -1,0 +1,265 @@
+// The neighbour list (search/neighbour_list.hpp) against a brute-force search over all pairs:
+// the same pairs in the same order, a refresh exactly when some particle has moved more than
+// half the skin, and the history of kept pairs carried over a rebuild.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <map>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include "millsim/search/neighbour_list.hpp"
+
+namespace millsim {
+namespace {
+
+using PairList = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+
+/// A cloud of `count` particles of radius 0.5–1.5 in a cube (square) of side `side`.
+template <int D>
+struct Cloud {
+  std::vector<Vec<D>> position;
+  std::vector<double> radius;
+};
+
+template <int D>
+Cloud<D> random_cloud(std::size_t count, double side, std::uint64_t seed) {
+  std::mt19937_64 random(seed);
+  std::uniform_real_distribution<double> where(0.0, side);
+  std::uniform_real_distribution<double> size(0.5, 1.5);
+  Cloud<D> cloud;
+  for (std::size_t i = 0; i < count; ++i) {
+    Vec<D> x;
+    for (int a = 0; a < D; ++a) x[a] = where(random);
+    cloud.position.push_back(x);
+    cloud.radius.push_back(size(random));
+  }
+  return cloud;
+}
+
+/// Every pair i < j closer than r_i + r_j + skin, in (i, j) order: the definition of the list.
+template <int D>
+PairList brute_force_pairs(const Cloud<D>& cloud, double skin) {
+  PairList pairs;
+  for (std::uint32_t i = 0; i < cloud.position.size(); ++i) {
+    for (std::uint32_t j = i + 1; j < cloud.position.size(); ++j) {
+      const double reach = cloud.radius[i] + cloud.radius[j] + skin;
+      // distance < reach, compared squared (both sides are positive).
+      if (norm_squared(cloud.position[j] - cloud.position[i]) < reach * reach) {
+        pairs.emplace_back(i, j);
+      }
+    }
+  }
+  return pairs;
+}
+
+template <int D>
+PairList listed_pairs(const NeighbourList<D>& list) {
+  PairList pairs;
+  for (std::size_t p = 0; p < list.pair_count(); ++p) {
+    pairs.emplace_back(list.first()[p], list.second()[p]);
+  }
+  return pairs;
+}
+
+template <int D>
+void expect_default(const ContactHistory<D>& h) {
+  EXPECT_EQ(h.normal_spring_origin, 0.0);
+  EXPECT_EQ(h.tangential_spring, Vec<D>{});
+  EXPECT_EQ(h.dissipated, 0.0);
+  EXPECT_EQ(h.overlap, 0.0);
+  EXPECT_FALSE(h.touching);
+}
+
+// 300 particles, radii uniform in [0.5, 1.5], placed independently (so some overlap), skin 0.3.
+// A pair is listed when its centres are within s = r_i + r_j + 0.3, with E[s²] = 2.3² + 1/6
+// = 5.46 and E[s³] = 2.3³ + 3 × 2.3 / 6 = 13.3. Expected pairs, 300 × 299 / 2 = 44850 times the
+// chance of being within s: 2D, side 40: 44850 × π × 5.46 / 1600 ≈ 480 pairs (3.2 per disc);
+// 3D, side 14: 44850 × 4π/3 × 13.3 / 2744 ≈ 910 pairs (6 per sphere).
+constexpr std::size_t cloud_size = 300;
+constexpr double skin = 0.3;
+template <int D>
+constexpr double box_side = D == 2 ? 40.0 : 14.0;
+
+template <int D>
+void check_matches_brute_force(std::uint64_t seed) {
+  const Cloud<D> cloud = random_cloud<D>(cloud_size, box_side<D>, seed);
+  NeighbourList<D> list(skin);
+  list.rebuild(cloud.position, cloud.radius);
+  const PairList expected = brute_force_pairs(cloud, skin);
+  ASSERT_GT(expected.size(), cloud_size) << "the cloud should have more pairs than particles";
+  EXPECT_EQ(listed_pairs(list), expected);
+  EXPECT_EQ(list.history().size(), expected.size());
+  EXPECT_EQ(list.rebuild_count(), 1);
+}
+
+TEST(NeighbourList, DiscPairsEqualBruteForceSortedByFirstThenSecond) {
+  for (std::uint64_t seed : {1u, 2u, 3u}) check_matches_brute_force<2>(seed);
+}
+
+TEST(NeighbourList, SpherePairsEqualBruteForceSortedByFirstThenSecond) {
+  for (std::uint64_t seed : {1u, 2u, 3u}) check_matches_brute_force<3>(seed);
+}
+
+TEST(NeighbourList, WideSpreadCloudStillMatchesBruteForce) {
+  // Two clumps 10⁴ apart: the grid grows its cells rather than holding 10⁸ of them, and the
+  // pairs must not change.
+  Cloud<2> cloud = random_cloud<2>(200, 20.0, 7);
+  for (std::size_t i = 100; i < 200; ++i) cloud.position[i] += Vec2{{1.0e4, 1.0e4}};
+  NeighbourList<2> list(skin);
+  list.rebuild(cloud.position, cloud.radius);
+  EXPECT_EQ(listed_pairs(list), brute_force_pairs(cloud, skin));
+}
+
+TEST(NeighbourList, PairExactlyAtReachIsNotListed) {
+  // Radii 1 and 1, skin 1: reach = 1 + 1 + 1 = 3. Centres 3 apart (3² = 9 = reach² exactly in
+  // binary) are not listed (distance < reach is the rule); 2.999 apart are.
+  NeighbourList<2> list(1.0);
+  list.rebuild({Vec2{{0.0, 0.0}}, Vec2{{3.0, 0.0}}}, {1.0, 1.0});
+  EXPECT_EQ(list.pair_count(), 0u);
+  list.rebuild({Vec2{{0.0, 0.0}}, Vec2{{2.999, 0.0}}}, {1.0, 1.0});
+  EXPECT_EQ(listed_pairs(list), (PairList{{0, 1}}));
+}
+
+template <int D>
+void check_refresh_rule() {
+  Cloud<D> cloud = random_cloud<D>(cloud_size, box_side<D>, 11);
+  NeighbourList<D> list(skin);
+  EXPECT_TRUE(list.needs_refresh(cloud.position)) << "never built";
+  list.rebuild(cloud.position, cloud.radius);
+  EXPECT_FALSE(list.needs_refresh(cloud.position));
+
+  // Every particle moves 0.49 skin in its own random direction: no refresh yet.
+  std::mt19937_64 random(12);
+  std::normal_distribution<double> gauss;
+  const auto random_unit = [&] {
+    Vec<D> u;
+    for (int a = 0; a < D; ++a) u[a] = gauss(random);
+    return u * (1.0 / norm(u));
+  };
+  Cloud<D> moved = cloud;
+  for (auto& x : moved.position) x += (0.49 * skin) * random_unit();
+  EXPECT_FALSE(list.needs_refresh(moved.position));
+
+  // Safety of the rule: with every particle moved less than skin/2, every pair that now
+  // overlaps (distance < r_i + r_j) is in the list, since it was closer than
+  // r_i + r_j + 2 × skin/2 before. (The cloud is placed at random, so some pairs overlap.)
+  const PairList listed = listed_pairs(list);
+  std::size_t overlapping = 0;
+  for (const auto& [i, j] : brute_force_pairs(moved, 0.0)) {
+    ++overlapping;
+    EXPECT_TRUE(std::binary_search(listed.begin(), listed.end(), std::pair{i, j}))
+        << "pair " << i << "-" << j << " touches but is not listed";
+  }
+  EXPECT_GT(overlapping, 0u);
+
+  // One particle moves 0.51 skin: refresh. The rule is on the distance, not per axis: a move of
+  // 0.3 skin along every axis is 0.3 sqrt(D) skin = 0.42 (2D) or 0.52 (3D) skin.
+  Cloud<D> one_moved = cloud;
+  one_moved.position[123] += (0.51 * skin) * random_unit();
+  EXPECT_TRUE(list.needs_refresh(one_moved.position));
+  Vec<D> diagonal;
+  for (int a = 0; a < D; ++a) diagonal[a] = 0.3 * skin;
+  Cloud<D> diagonal_moved = cloud;
+  diagonal_moved.position[45] += diagonal;
+  EXPECT_EQ(list.needs_refresh(diagonal_moved.position), D == 3);
+
+  // A rebuild takes the new positions as the reference.
+  list.rebuild(one_moved.position, one_moved.radius);
+  EXPECT_FALSE(list.needs_refresh(one_moved.position));
+  EXPECT_EQ(list.rebuild_count(), 2);
+
+  // A particle added (or removed) always asks for a refresh.
+  one_moved.position.push_back(one_moved.position[0]);
+  EXPECT_TRUE(list.needs_refresh(one_moved.position));
+  one_moved.position.pop_back();
+  one_moved.position.pop_back();
+  EXPECT_TRUE(list.needs_refresh(one_moved.position));
+}
+
+TEST(NeighbourList, RefreshOnlyAfterAMoveOfMoreThanHalfTheSkinDiscs) {
+  check_refresh_rule<2>();
+}
+
+TEST(NeighbourList, RefreshOnlyAfterAMoveOfMoreThanHalfTheSkinSpheres) {
+  check_refresh_rule<3>();
+}
+
+template <int D>
+void check_history_carry_over() {
+  Cloud<D> cloud = random_cloud<D>(cloud_size, box_side<D>, 21);
+  NeighbourList<D> list(skin);
+  list.rebuild(cloud.position, cloud.radius);
+
+  // Mark every pair's history with a value unique to the pair, in every field.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, double> marker;
+  for (std::size_t p = 0; p < list.pair_count(); ++p) {
+    const double m = 1000.0 + static_cast<double>(p);
+    marker[{list.first()[p], list.second()[p]}] = m;
+    ContactHistory<D>& h = list.history()[p];
+    h.dissipated = m;
+    h.normal_spring_origin = -m;
+    h.overlap = 2.0 * m;
+    h.tangential_spring[0] = 3.0 * m;
+    h.touching = true;
+  }
+
+  // Everyone jiggles by up to 0.1 skin per axis (most pairs stay within reach, a few at the
+  // margin may leave it); particles 0, 50, 100, ... jump to a new random place in the box, so
+  // they drop their old pairs and find new ones.
+  std::mt19937_64 random(22);
+  std::uniform_real_distribution<double> jiggle(-0.1 * skin, 0.1 * skin);
+  std::uniform_real_distribution<double> where(0.0, box_side<D>);
+  for (std::size_t i = 0; i < cloud.position.size(); ++i) {
+    for (int a = 0; a < D; ++a) {
+      cloud.position[i][a] = i % 50 == 0 ? where(random) : cloud.position[i][a] + jiggle(random);
+    }
+  }
+  list.rebuild(cloud.position, cloud.radius);
+  const PairList now = brute_force_pairs(cloud, skin);
+  ASSERT_EQ(listed_pairs(list), now) << "dropped pairs are gone, new ones are in";
+
+  std::size_t kept = 0;
+  std::size_t fresh = 0;
+  for (std::size_t p = 0; p < list.pair_count(); ++p) {
+    const ContactHistory<D>& h = list.history()[p];
+    const auto found = marker.find({list.first()[p], list.second()[p]});
+    if (found == marker.end()) {
+      ++fresh;
+      expect_default(h);
+    } else {
+      ++kept;
+      const double m = found->second;
+      EXPECT_EQ(h.dissipated, m);
+      EXPECT_EQ(h.normal_spring_origin, -m);
+      EXPECT_EQ(h.overlap, 2.0 * m);
+      EXPECT_EQ(h.tangential_spring[0], 3.0 * m);
+      EXPECT_TRUE(h.touching);
+    }
+  }
+  const std::size_t dropped = marker.size() - kept;
+  // The test means something only if all three kinds occur.
+  EXPECT_GT(kept, 0u);
+  EXPECT_GT(fresh, 0u);
+  EXPECT_GT(dropped, 0u);
+}
+
+TEST(NeighbourList, KeptPairsKeepTheirHistoryNewPairsStartClearDiscs) {
+  check_history_carry_over<2>();
+}
+
+TEST(NeighbourList, KeptPairsKeepTheirHistoryNewPairsStartClearSpheres) {
+  check_history_carry_over<3>();
+}
+
+TEST(NeighbourList, EmptyListStaysEmpty) {
+  NeighbourList<2> list(0.1);
+  list.rebuild({}, {});
+  EXPECT_EQ(list.pair_count(), 0u);
+  EXPECT_FALSE(list.needs_refresh({}));
+}
+
+}  // namespace
+}  // namespace millsim
