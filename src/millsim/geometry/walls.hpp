@@ -54,6 +54,9 @@ struct Walls {
   int wall_count() const {
     return (mill ? 1 + mill->lifter_count : 0) + static_cast<int>(planes.size());
   }
+  /// False when no wall can come within `margin` of the particle, however the mill turns: it
+  /// then needs no wall search until it has moved `margin` (the contact search's skin).
+  bool may_touch(const Vec<D>& centre, double particle_radius, double margin) const;
   /// Calls emit(const WallContact<D>&) for every wall the particle overlaps.
   template <typename Emit>
   void for_each_contact(const Vec<D>& centre, double particle_radius, Emit&& emit) const;
@@ -63,6 +66,22 @@ struct Walls {
 /// Writes at most 4 contacts (shell and up to three lifters) and returns how many.
 int mill_contacts(const Mill2D& mill, const Vec2& centre, double particle_radius,
                   WallContact<2>* out);
+
+template <int D>
+bool Walls<D>::may_touch(const Vec<D>& centre, double particle_radius, double margin) const {
+  const double reach = particle_radius + margin;
+  if constexpr (D == 2) {
+    if (mill) {
+      // Lifters sweep the ring between R − h and R as the mill turns.
+      const double inner = mill->radius - (mill->lifter_count > 0 ? mill->lifter_height : 0.0);
+      if (norm(centre) + reach > inner) return true;
+    }
+  }
+  for (const Plane<D>& plane : planes) {
+    if (dot(centre - plane.point, plane.normal) < reach) return true;
+  }
+  return false;
+}
 
 template <int D>
 template <typename Emit>

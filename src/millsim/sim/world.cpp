@@ -17,7 +17,24 @@ ContactType wall_contact_type(WallKind kind) {
   return ContactType::ball_plane;
 }
 
+/// Blocks of a fixed size: the unit of parallel work and of partial sums.
+constexpr std::size_t pair_block = 1024;
+constexpr std::size_t wall_block = 256;
+/// Below this many items a stage runs on one thread (a parallel region costs microseconds).
+constexpr std::size_t parallel_threshold = 2048;
+
+std::size_t block_count(std::size_t items, std::size_t block) {
+  return (items + block - 1) / block;
+}
+
 }  // namespace
+
+template <int D>
+WallKind World<D>::wall_kind(int wall_id) const {
+  if (walls_.mill && wall_id == 0) return WallKind::shell;
+  if (walls_.mill && wall_id <= walls_.mill->lifter_count) return WallKind::lifter;
+  return WallKind::plane;
+}
 
 template <int D>
 World<D>::World(const WorldSettings<D>& settings, const Walls<D>& walls)
@@ -56,8 +73,40 @@ void World<D>::refresh_neighbours() {
     neighbours_ = NeighbourList<D>(settings_.skin);
   }
   neighbours_.rebuild(particles_.position, particles_.radius);
-  pair_force_.resize(neighbours_.pair_count());
-  pair_moment_.resize(neighbours_.pair_count());
+  const std::size_t pairs = neighbours_.pair_count();
+  pair_force_.resize(pairs);
+  pair_moment_.resize(pairs);
+  pair_ended_.resize(pairs);
+  pair_block_ended_.resize(block_count(pairs, pair_block));
+  pair_block_dissipated_.resize(block_count(pairs, pair_block));
+
+  // Wall candidates: a particle further than a skin from every wall cannot reach one before
+  // it has moved half a skin, which triggers the next rebuild. One that leaves the list has
+  // no wall contact left (it is a skin away); any slot it still holds ends here.
+  wall_candidates_.clear();
+  wall_force_.assign(count, Vec<D>{});
+  wall_moment_.assign(count, Spin<D>{});
+  for (std::size_t i = 0; i < count; ++i) {
+    if (walls_.may_touch(particles_.position[i], particles_.radius[i], settings_.skin)) {
+      wall_candidates_.push_back(static_cast<std::uint32_t>(i));
+      continue;
+    }
+    for (std::size_t slot = i * max_wall_contacts; slot < (i + 1) * max_wall_contacts; ++slot) {
+      if (wall_slot_id_[slot] < 0) continue;
+      if (spectrum_ != nullptr) {
+        spectrum_->record(wall_contact_type(wall_kind(wall_slot_id_[slot])),
+                          wall_slot_history_[slot].dissipated);
+      }
+      wall_slot_id_[slot] = -1;
+      wall_slot_history_[slot] = ContactHistory<D>{};
+    }
+  }
+  const std::size_t candidates = wall_candidates_.size();
+  wall_ended_.resize(candidates * max_wall_contacts);
+  wall_block_ended_.resize(block_count(candidates, wall_block));
+  wall_block_dissipated_.resize(block_count(candidates, wall_block));
+  wall_block_torque_.resize(block_count(candidates, wall_block));
+  wall_block_work_.resize(block_count(candidates, wall_block));
 }
 
 template <int D>
@@ -66,18 +115,25 @@ void World<D>::estimate_current_velocities() {
   velocity_now_.resize(count);
   spin_now_.resize(count);
   const double half_step = 0.5 * settings_.time_step;
+  const auto& p = particles_;
+#pragma omp parallel for schedule(static) if (count >= parallel_threshold)
   for (std::size_t i = 0; i < count; ++i) {
-    velocity_now_[i] =
-        particles_.velocity[i] + (half_step * particles_.inverse_mass[i]) * particles_.force[i];
-    spin_now_[i] = particles_.angular_velocity[i] +
-                   (half_step * particles_.inverse_inertia[i]) * particles_.torque[i];
+    velocity_now_[i] = p.velocity[i] + (half_step * p.inverse_mass[i]) * p.force[i];
+    spin_now_[i] = p.angular_velocity[i] + (half_step * p.inverse_inertia[i]) * p.torque[i];
   }
 }
 
 template <int D>
-void World<D>::end_collision(ContactType type, ContactHistory<D>& history) {
-  if (spectrum_ != nullptr) spectrum_->record(type, history.dissipated);
-  history = ContactHistory<D>{};
+void World<D>::record_ended(const std::vector<EndedCollision>& ended,
+                            const std::vector<std::uint32_t>& block_ended,
+                            std::size_t block_capacity) {
+  if (spectrum_ == nullptr) return;
+  for (std::size_t b = 0; b < block_ended.size(); ++b) {
+    for (std::size_t k = 0; k < block_ended[b]; ++k) {
+      const EndedCollision& e = ended[b * block_capacity + k];
+      spectrum_->record(e.type, e.energy);
+    }
+  }
 }
 
 template <int D>
@@ -93,117 +149,157 @@ void World<D>::evaluate_pair_contacts() {
   const auto& r = particles_.radius;
   const auto& m = particles_.mass;
   const double dt = settings_.time_step;
-  double dissipated = 0.0;
-  for (std::size_t p = 0; p < first.size(); ++p) {
-    const std::uint32_t a = first[p];
-    const std::uint32_t b = second[p];
-    const Vec<D> offset = x[b] - x[a];
-    const double distance_squared = norm_squared(offset);
-    const double reach = r[a] + r[b];
-    if (distance_squared >= reach * reach) {
-      if (history[p].touching) end_collision(ContactType::ball_ball, history[p]);
-      pair_force_[p] = Vec<D>{};
-      pair_moment_[p] = Spin<D>{};
-      continue;
+  const std::size_t pairs = first.size();
+  const std::size_t blocks = pair_block_ended_.size();
+#pragma omp parallel for schedule(static) if (pairs >= parallel_threshold)
+  for (std::size_t b = 0; b < blocks; ++b) {
+    double dissipated = 0.0;
+    std::uint32_t ended = 0;
+    const std::size_t end = std::min(pairs, (b + 1) * pair_block);
+    for (std::size_t p = b * pair_block; p < end; ++p) {
+      const std::uint32_t i = first[p];
+      const std::uint32_t j = second[p];
+      const Vec<D> offset = x[j] - x[i];
+      const double distance_squared = norm_squared(offset);
+      const double reach = r[i] + r[j];
+      if (distance_squared >= reach * reach) {
+        if (history[p].touching) {
+          pair_ended_[b * pair_block + ended++] = {ContactType::ball_ball, history[p].dissipated};
+          history[p] = ContactHistory<D>{};
+        }
+        pair_force_[p] = Vec<D>{};
+        pair_moment_[p] = Spin<D>{};
+        continue;
+      }
+      const double distance = std::sqrt(distance_squared);
+      ContactInput<D> in;
+      in.normal = offset * (1.0 / distance);
+      in.overlap = reach - distance;
+      in.velocity = v[j] - v[i];
+      in.spin_velocity = cross(in.normal, r[i] * w[i] + r[j] * w[j]);
+      in.step_velocity = step_v[j] - step_v[i];
+      in.step_spin_velocity = cross(in.normal, r[i] * step_w[i] + r[j] * step_w[j]);
+      in.effective_mass = m[i] * m[j] / (m[i] + m[j]);
+      history[p].touching = true;
+      history[p].overlap = in.overlap;
+      const ContactOutput<D> out = ball_ball_law_.evaluate(in, history[p], dt);
+      pair_force_[p] = out.force;
+      pair_moment_[p] = -cross(in.normal, out.tangential_force);
+      dissipated += out.dissipated;
     }
-    const double distance = std::sqrt(distance_squared);
-    ContactInput<D> in;
-    in.normal = offset * (1.0 / distance);
-    in.overlap = reach - distance;
-    in.velocity = v[b] - v[a];
-    in.spin_velocity = cross(in.normal, r[a] * w[a] + r[b] * w[b]);
-    in.step_velocity = step_v[b] - step_v[a];
-    in.step_spin_velocity = cross(in.normal, r[a] * step_w[a] + r[b] * step_w[b]);
-    in.effective_mass = m[a] * m[b] / (m[a] + m[b]);
-    history[p].touching = true;
-    history[p].overlap = in.overlap;
-    const ContactOutput<D> out = ball_ball_law_.evaluate(in, history[p], dt);
-    pair_force_[p] = out.force;
-    pair_moment_[p] = -cross(in.normal, out.tangential_force);
-    dissipated += out.dissipated;
+    pair_block_dissipated_[b] = dissipated;
+    pair_block_ended_[b] = ended;
   }
-  last_step_dissipation_ = dissipated;
+  last_step_dissipation_ = 0.0;
+  for (const double d : pair_block_dissipated_) last_step_dissipation_ += d;
+  record_ended(pair_ended_, pair_block_ended_, pair_block);
 }
 
 template <int D>
 void World<D>::evaluate_wall_contacts() {
   const double dt = settings_.time_step;
-  double torque = 0.0;
-  double work = 0.0;
-  double dissipated = 0.0;
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    std::int32_t* slot_id = &wall_slot_id_[i * max_wall_contacts];
-    ContactHistory<D>* slot_history = &wall_slot_history_[i * max_wall_contacts];
-    std::array<bool, max_wall_contacts> seen{};
-    Vec<D> force{};
-    Spin<D> moment{};
-    const double radius = particles_.radius[i];
-    walls_.for_each_contact(particles_.position[i], radius, [&](const WallContact<D>& contact) {
-      int slot = 0;
-      while (slot < max_wall_contacts && slot_id[slot] != contact.wall_id) ++slot;
-      if (slot == max_wall_contacts) {
-        slot = 0;
-        while (slot < max_wall_contacts && slot_id[slot] >= 0) ++slot;
-        if (slot == max_wall_contacts) return;  // cannot happen: at most 4 walls reach a disc
-        slot_id[slot] = contact.wall_id;
+  const std::size_t candidates = wall_candidates_.size();
+  const std::size_t blocks = wall_block_ended_.size();
+#pragma omp parallel for schedule(static) if (candidates >= parallel_threshold)
+  for (std::size_t b = 0; b < blocks; ++b) {
+    double torque = 0.0;
+    double work = 0.0;
+    double dissipated = 0.0;
+    std::uint32_t ended = 0;
+    EndedCollision* block_ended = &wall_ended_[b * wall_block * max_wall_contacts];
+    const std::size_t end = std::min(candidates, (b + 1) * wall_block);
+    for (std::size_t k = b * wall_block; k < end; ++k) {
+      const std::size_t i = wall_candidates_[k];
+      std::int32_t* slot_id = &wall_slot_id_[i * max_wall_contacts];
+      ContactHistory<D>* slot_history = &wall_slot_history_[i * max_wall_contacts];
+      std::array<bool, max_wall_contacts> seen{};
+      Vec<D> force{};
+      Spin<D> moment{};
+      const double radius = particles_.radius[i];
+      walls_.for_each_contact(particles_.position[i], radius, [&](const WallContact<D>& contact) {
+        int slot = 0;
+        while (slot < max_wall_contacts && slot_id[slot] != contact.wall_id) ++slot;
+        if (slot == max_wall_contacts) {
+          slot = 0;
+          while (slot < max_wall_contacts && slot_id[slot] >= 0) ++slot;
+          if (slot == max_wall_contacts) return;  // cannot happen: at most 4 walls reach a disc
+          slot_id[slot] = contact.wall_id;
+        }
+        seen[static_cast<std::size_t>(slot)] = true;
+        ContactInput<D> in;
+        in.normal = contact.normal;
+        in.overlap = contact.overlap;
+        in.velocity = velocity_now_[i] - contact.wall_velocity;
+        in.spin_velocity = cross(contact.normal, radius * spin_now_[i]);
+        in.step_velocity = particles_.velocity[i] - contact.wall_velocity;
+        in.step_spin_velocity = cross(contact.normal, radius * particles_.angular_velocity[i]);
+        in.effective_mass = particles_.mass[i];
+        ContactHistory<D>& history = slot_history[slot];
+        history.touching = true;
+        history.overlap = contact.overlap;
+        const ContactOutput<D> out = ball_wall_law_.evaluate(in, history, dt);
+        force += out.force;
+        moment += -radius * cross(contact.normal, out.tangential_force);
+        dissipated += out.dissipated;
+        if (contact.kind != WallKind::plane) {
+          if constexpr (D == 2) torque += cross(contact.point, out.force);
+          work += dot(out.force, contact.wall_velocity) * dt;
+        }
+      });
+      for (int slot = 0; slot < max_wall_contacts; ++slot) {
+        if (slot_id[slot] < 0 || seen[static_cast<std::size_t>(slot)]) continue;
+        block_ended[ended++] = {wall_contact_type(wall_kind(slot_id[slot])),
+                                slot_history[slot].dissipated};
+        slot_history[slot] = ContactHistory<D>{};
+        slot_id[slot] = -1;
       }
-      seen[static_cast<std::size_t>(slot)] = true;
-      ContactInput<D> in;
-      in.normal = contact.normal;
-      in.overlap = contact.overlap;
-      in.velocity = velocity_now_[i] - contact.wall_velocity;
-      in.spin_velocity = cross(contact.normal, radius * spin_now_[i]);
-      in.step_velocity = particles_.velocity[i] - contact.wall_velocity;
-      in.step_spin_velocity = cross(contact.normal, radius * particles_.angular_velocity[i]);
-      in.effective_mass = particles_.mass[i];
-      ContactHistory<D>& history = slot_history[slot];
-      history.touching = true;
-      history.overlap = contact.overlap;
-      const ContactOutput<D> out = ball_wall_law_.evaluate(in, history, dt);
-      force += out.force;
-      moment += -radius * cross(contact.normal, out.tangential_force);
-      dissipated += out.dissipated;
-      if (contact.kind != WallKind::plane) {
-        if constexpr (D == 2) torque += cross(contact.point, out.force);
-        work += dot(out.force, contact.wall_velocity) * dt;
-      }
-    });
-    for (int slot = 0; slot < max_wall_contacts; ++slot) {
-      if (slot_id[slot] < 0 || seen[static_cast<std::size_t>(slot)]) continue;
-      const int id = slot_id[slot];
-      const WallKind kind = walls_.mill && id == 0                           ? WallKind::shell
-                            : walls_.mill && id <= walls_.mill->lifter_count ? WallKind::lifter
-                                                                             : WallKind::plane;
-      end_collision(wall_contact_type(kind), slot_history[slot]);
-      slot_id[slot] = -1;
+      wall_force_[i] = force;
+      wall_moment_[i] = moment;
     }
-    particles_.force[i] = force;
-    particles_.torque[i] = moment;
+    wall_block_torque_[b] = torque;
+    wall_block_work_[b] = work;
+    wall_block_dissipated_[b] = dissipated;
+    wall_block_ended_[b] = ended;
+  }
+  double torque = 0.0;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    torque += wall_block_torque_[b];
+    account_.shell_work += wall_block_work_[b];
+    last_step_dissipation_ += wall_block_dissipated_[b];
   }
   shell_torque_ = torque;
-  account_.shell_work += work;
-  last_step_dissipation_ += dissipated;
   account_.dissipated += last_step_dissipation_;
+  record_ended(wall_ended_, wall_block_ended_, wall_block * max_wall_contacts);
 }
 
 template <int D>
 void World<D>::accumulate_forces() {
-  // Fixed order: pairs in list order, so the sums are the same on every run.
-  const auto& first = neighbours_.first();
-  const auto& second = neighbours_.second();
+  // Each particle gathers its own forces in a fixed order (walls, pairs where it is first,
+  // pairs where it is second, gravity), so the sums are the same on every run and thread count.
+  const auto& first_begin = neighbours_.first_begin();
+  const auto& second_begin = neighbours_.second_begin();
+  const auto& second_pairs = neighbours_.second_pairs();
   auto& force = particles_.force;
   auto& torque = particles_.torque;
   const auto& r = particles_.radius;
-  for (std::size_t p = 0; p < first.size(); ++p) {
-    const std::uint32_t a = first[p];
-    const std::uint32_t b = second[p];
-    force[b] += pair_force_[p];
-    force[a] -= pair_force_[p];
-    torque[a] += r[a] * pair_moment_[p];
-    torque[b] += r[b] * pair_moment_[p];
-  }
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    force[i] += particles_.mass[i] * settings_.gravity;
+  const auto& m = particles_.mass;
+  const Vec<D> gravity = settings_.gravity;
+  const std::size_t count = particles_.size();
+#pragma omp parallel for schedule(static) if (count >= parallel_threshold)
+  for (std::size_t i = 0; i < count; ++i) {
+    Vec<D> f = wall_force_[i];
+    Spin<D> moment = wall_moment_[i];
+    for (std::uint32_t p = first_begin[i]; p < first_begin[i + 1]; ++p) {
+      f -= pair_force_[p];
+      moment += r[i] * pair_moment_[p];
+    }
+    for (std::uint32_t k = second_begin[i]; k < second_begin[i + 1]; ++k) {
+      const std::uint32_t p = second_pairs[k];
+      f += pair_force_[p];
+      moment += r[i] * pair_moment_[p];
+    }
+    force[i] = f + m[i] * gravity;
+    torque[i] = moment;
   }
 }
 
@@ -211,10 +307,13 @@ template <int D>
 void World<D>::integrate() {
   // Leapfrog: u̇(n+½) = u̇(n−½) + ü(n) Δt, u(n+1) = u(n) + u̇(n+½) Δt; the same for rotation.
   const double dt = settings_.time_step;
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    particles_.velocity[i] += (particles_.inverse_mass[i] * dt) * particles_.force[i];
-    particles_.position[i] += dt * particles_.velocity[i];
-    particles_.angular_velocity[i] += (particles_.inverse_inertia[i] * dt) * particles_.torque[i];
+  auto& p = particles_;
+  const std::size_t count = p.size();
+#pragma omp parallel for schedule(static) if (count >= parallel_threshold)
+  for (std::size_t i = 0; i < count; ++i) {
+    p.velocity[i] += (p.inverse_mass[i] * dt) * p.force[i];
+    p.position[i] += dt * p.velocity[i];
+    p.angular_velocity[i] += (p.inverse_inertia[i] * dt) * p.torque[i];
   }
 }
 

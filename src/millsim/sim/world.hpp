@@ -75,7 +75,17 @@ class World {
   void integrate();
   void advance_walls();
 
-  void end_collision(ContactType type, ContactHistory<D>& history);
+  WallKind wall_kind(int wall_id) const;
+
+  /// A collision that ended in a parallel stage, recorded in the spectrum after it in a fixed
+  /// order (blocks in order, then in the order they were found), so any thread count gives the
+  /// same spectrum.
+  struct EndedCollision {
+    ContactType type = ContactType::ball_ball;
+    double energy = 0.0;
+  };
+  void record_ended(const std::vector<EndedCollision>& ended,
+                    const std::vector<std::uint32_t>& block_ended, std::size_t block_capacity);
 
   WorldSettings<D> settings_;
   Walls<D> walls_;
@@ -90,13 +100,28 @@ class World {
   // work the leapfrog update does (docs/model.md, "energy account").
   std::vector<Vec<D>> velocity_now_;
   std::vector<Spin<D>> spin_now_;
+
+  // Work is split in blocks of a fixed size; each block keeps its own sums and ended
+  // collisions, added up in block order, so results do not depend on the number of threads.
   // Per pair of the neighbour list: force on the second particle and the moment per unit
   // radius, −n × F_t, that both particles receive (scaled by their radii).
   std::vector<Vec<D>> pair_force_;
   std::vector<Spin<D>> pair_moment_;
+  std::vector<EndedCollision> pair_ended_;  // block b's at [b × pair_block, ...)
+  std::vector<std::uint32_t> pair_block_ended_;
+  std::vector<double> pair_block_dissipated_;
+
+  // Particles that may touch a wall before the next neighbour-list rebuild, and per particle
+  // the force and moment its walls exert (zero for the others).
+  std::vector<std::uint32_t> wall_candidates_;
+  std::vector<Vec<D>> wall_force_;
+  std::vector<Spin<D>> wall_moment_;
   // Per particle, max_wall_contacts slots of wall-contact history keyed by wall id.
   std::vector<std::int32_t> wall_slot_id_;
   std::vector<ContactHistory<D>> wall_slot_history_;
+  std::vector<EndedCollision> wall_ended_;  // block b's at [b × wall_block × max, ...)
+  std::vector<std::uint32_t> wall_block_ended_;
+  std::vector<double> wall_block_dissipated_, wall_block_torque_, wall_block_work_;
 
   double time_ = 0.0;
   long steps_ = 0;
