@@ -73,9 +73,10 @@ class ProgressLine {
 
 /// Plans, places the charge, and only then creates the output directory and runs, so that a
 /// config that cannot run writes nothing.
-MillResult run_job(const MillConfig& config, bool show_progress) {
-  const MillPlan plan = millsim::plan_mill(config);
-  millsim::World<2> world = millsim::build_mill_world(plan);
+template <int D>
+MillResult run_job(const MillPlan& plan, bool show_progress) {
+  const MillConfig& config = plan.config;
+  millsim::World<D> world = millsim::build_mill_world<D>(plan);
   const std::filesystem::path out = config.output_directory;
   if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
     throw millsim::InputError(fmt::format(
@@ -92,6 +93,11 @@ MillResult run_job(const MillConfig& config, bool show_progress) {
   progress.clear();
   millsim::write_results(out, result);
   return result;
+}
+
+MillResult run_job(const MillConfig& config, bool show_progress) {
+  const MillPlan plan = millsim::plan_mill(config);
+  return config.dimension == 2 ? run_job<2>(plan, show_progress) : run_job<3>(plan, show_progress);
 }
 
 int run_command(const JobOptions& options) {
@@ -118,13 +124,23 @@ int info_command(const JobOptions& options) {
              plan.speed_rpm, 100.0 * plan.speed_fraction, plan.revolution_period);
   fmt::print("charge                filling {}, porosity {}, density {} kg/m3; {}\n", c.filling,
              c.porosity, c.density, c.size_description);
+  const bool flat = c.dimension == 2;
   for (const auto& d : plan.discs) {
-    fmt::print("  discs               {:5d} x {:.4g} m, {:.4g} kg each\n", d.count, d.diameter,
-               d.mass);
+    fmt::print("  {}               {:5d} x {:.4g} m, {:.4g} kg each\n", flat ? "discs" : "balls",
+               d.count, d.diameter, d.mass);
   }
   fmt::print("particles             {}\n", plan.particle_count);
-  fmt::print("slice charge mass     {:.4g} kg; whole mill {:.4g} kg; power scale {:.4g}\n",
-             plan.slice_mass, plan.mill_charge_mass, plan.power_scale);
+  if (flat) {
+    fmt::print("model                 2D slice of discs, power scaled by charge mass\n");
+  } else if (c.periodic) {
+    fmt::print("model                 3D periodic slab {} m long, power scaled to the {} m mill\n",
+               c.slab_length, c.length);
+  } else {
+    fmt::print("model                 3D whole mill with flat end plates\n");
+  }
+  fmt::print("{:<22}{:.4g} kg; whole mill {:.4g} kg; power scale {:.4g}\n",
+             flat ? "slice charge mass" : "simulated charge mass", plan.slice_mass,
+             plan.mill_charge_mass, plan.power_scale);
   fmt::print("contact duration      ball-ball {:.4g} s, ball-wall {:.4g} s (smallest balls)\n",
              plan.contact_duration_ball_ball, plan.contact_duration_ball_wall);
   fmt::print("time step             {:.4g} s{} (stability limit {:.4g} s)\n", plan.time_step,

@@ -294,7 +294,7 @@ TEST(MillWall, TheExampleMillRunsBitForBitTheSameTwice) {
   const MillPlan plan =
       plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", overrides));
   const auto run = [&plan] {
-    World<2> world = build_mill_world(plan);
+    World<2> world = build_mill_world<2>(plan);
     for (int n = 0; n < 1500; ++n) world.step();
     world.walls().mill->angular_speed = plan.angular_speed;
     for (int n = 0; n < 1500; ++n) world.step();

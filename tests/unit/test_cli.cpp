@@ -264,10 +264,12 @@ TEST_F(Cli, RefusesMassFractionsThatDoNotSumToOne) {
                                     "allowed: mass fractions that sum to 1"});
 }
 
-TEST_F(Cli, RefusesThreeDimensionsClearly) {
-  const std::string text = with(base_config, "time_step", "dimension = 3\ntime_step = \"auto\"");
-  expect_refused(run_config(text), {at_line(text, "dimension"), "simulation.dimension",
-                                    "not available yet", "allowed: 2"});
+TEST_F(Cli, RefusesASlabTooShortForItsBalls) {
+  const std::string text =
+      with(with(base_config, "time_step", "dimension = 3\ntime_step = \"auto\""), "speed",
+           "speed = 0.5\nperiodic = true\nslab_length = 0.1");
+  expect_refused(run_config(text), {at_line(text, "slab_length"), "mill.slab_length", "too short",
+                                    "at least three largest ball diameters"});
 }
 
 TEST_F(Cli, RefusesANamedTimeStepOtherThanAuto) {

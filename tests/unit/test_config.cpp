@@ -295,12 +295,37 @@ TEST(Config, RefusesABadSizeListEntryAtItsLine) {
                              "given as well as charge.ball_diameter", "allowed: one of"});
 }
 
-TEST(Config, RefusesThreeDimensionsClearly) {
-  const std::string text = with(base_config, "time_step", "dimension = 3\ntime_step = \"auto\"");
-  expect_has(error_of(text), {at_line(text, "dimension"), "simulation.dimension",
-                              "not available yet", "allowed: 2"});
+TEST(Config, ReadsTheDimensionAndRefusesAnyOther) {
+  const std::string three = with(base_config, "time_step", "dimension = 3\ntime_step = \"auto\"");
+  EXPECT_EQ(parse_mill_config(three, file_name).dimension, 3);
+  EXPECT_EQ(parse_mill_config(base_config, file_name).dimension, 2);
   const std::string one = with(base_config, "time_step", "dimension = 1\ntime_step = \"auto\"");
-  expect_has(error_of(one), {at_line(one, "dimension"), "1 is not allowed", "allowed: 2"});
+  expect_has(error_of(one), {at_line(one, "dimension"), "simulation.dimension", "1 is not allowed",
+                             "allowed: 2 (a slice of discs) or 3 (spheres)"});
+}
+
+TEST(Config, ReadsAPeriodicSlabIn3DOnly) {
+  const std::string slab =
+      with(with(base_config, "time_step", "dimension = 3\ntime_step = \"auto\""), "speed",
+           "speed = 0.5\nperiodic = true\nslab_length = 0.2");
+  // A slab longer than the 0.15 m mill is refused; one within it is read.
+  expect_has(error_of(slab), {at_line(slab, "slab_length"), "mill.slab_length", "0.2",
+                              "at most mill.length = 0.15 m"});
+  const std::string ok = with(slab, "slab_length", "slab_length = 0.1");
+  const MillConfig c = parse_mill_config(ok, file_name);
+  EXPECT_TRUE(c.periodic);
+  EXPECT_DOUBLE_EQ(c.slab_length, 0.1);
+  // Periodic without a slab length, periodic in 2D, a slab length without periodic.
+  const std::string missing = with(slab, "slab_length", "");
+  expect_has(error_of(missing), {"mill.slab_length", "needed because mill.periodic = true"});
+  const std::string flat = with(base_config, "speed", "speed = 0.5\nperiodic = true");
+  expect_has(error_of(flat),
+             {at_line(flat, "periodic"), "mill.periodic", "needs simulation.dimension = 3"});
+  const std::string stray = with(base_config, "speed", "speed = 0.5\nslab_length = 0.1");
+  expect_has(error_of(stray),
+             {at_line(stray, "slab_length"), "mill.slab_length", "mill.periodic is not true"});
+  const std::string typed = with(slab, "periodic", "periodic = \"yes\"");
+  expect_has(error_of(typed), {at_line(typed, "periodic"), "mill.periodic", "allowed: true"});
 }
 
 TEST(Config, RefusesATimeStepThatIsNotANumberOrAuto) {

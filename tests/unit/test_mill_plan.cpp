@@ -211,25 +211,25 @@ void expect_placed_without_contacts(const MillPlan& plan, const World<2>& world)
 
 TEST(MillPlan, ChargeIsPlacedWithoutTouchingWallsOrEachOther) {
   const MillPlan plan = plan_mill(lab_mill());
-  const World<2> world = build_mill_world(plan);
+  const World<2> world = build_mill_world<2>(plan);
   expect_placed_without_contacts(plan, world);
   EXPECT_EQ(world.walls().mill->angular_speed, 0.0) << "the shell starts still";
   EXPECT_EQ(world.settings().time_step, plan.time_step);
   EXPECT_EQ(world.settings().gravity, (Vec2{{0.0, -9.81}}));
 
   const MillPlan graded = plan_mill(graded_lab_mill());
-  expect_placed_without_contacts(graded, build_mill_world(graded));
+  expect_placed_without_contacts(graded, build_mill_world<2>(graded));
 }
 
 TEST(MillPlan, PlacementIsDecidedByTheSeed) {
   const MillPlan plan = plan_mill(lab_mill());
-  const World<2> a = build_mill_world(plan);
-  const World<2> b = build_mill_world(plan);
+  const World<2> a = build_mill_world<2>(plan);
+  const World<2> b = build_mill_world<2>(plan);
   EXPECT_EQ(a.particles().position, b.particles().position) << "same seed, same bits";
   EXPECT_EQ(a.particles().radius, b.particles().radius);
 
   const MillPlan other = plan_mill(lab_mill({"simulation.seed=2"}));
-  const World<2> c = build_mill_world(other);
+  const World<2> c = build_mill_world<2>(other);
   ASSERT_EQ(c.particles().size(), a.particles().size());
   std::size_t differing = 0;
   for (std::size_t i = 0; i < a.particles().size(); ++i) {

@@ -18,7 +18,8 @@ namespace millsim {
 namespace {
 
 constexpr ContactType all_types[] = {ContactType::ball_ball, ContactType::ball_shell,
-                                     ContactType::ball_lifter, ContactType::ball_plane};
+                                     ContactType::ball_lifter, ContactType::ball_end_plate,
+                                     ContactType::ball_plane};
 
 /// The bin one energy lands in (checks that it lands in exactly one).
 std::size_t bin_of(double energy, const ImpactSpectrum& empty = ImpactSpectrum{}) {
@@ -168,6 +169,7 @@ TEST(ImpactSpectrum, ContactTypesHaveTheirColumnNames) {
   EXPECT_EQ(contact_type_name(ContactType::ball_ball), "ball_ball");
   EXPECT_EQ(contact_type_name(ContactType::ball_shell), "ball_shell");
   EXPECT_EQ(contact_type_name(ContactType::ball_lifter), "ball_lifter");
+  EXPECT_EQ(contact_type_name(ContactType::ball_end_plate), "ball_end_plate");
   EXPECT_EQ(contact_type_name(ContactType::ball_plane), "ball_plane");
   // One name per type, and contact_type_count covers them all.
   EXPECT_EQ(std::size(all_types), contact_type_count);

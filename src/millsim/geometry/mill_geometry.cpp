@@ -7,15 +7,18 @@
 namespace millsim {
 namespace {
 
-/// Contact of a disc with lifter `index`, a rectangle that in the lifter's own frame (radial
-/// axis a, tangential axis b) spans a ∈ [R − h, R + h], b ∈ [−w/2, w/2]; the part beyond the
-/// shell (a > R) is out of reach and only closes the shape. Returns false when not touching.
-bool lifter_contact(const Mill2D& mill, int index, const Vec2& centre, double particle_radius,
-                    WallContact<2>& contact) {
+/// Closest point of lifter `index` to a particle centre, in the lifter's own frame: radial
+/// axis a, tangential axis b (and the mill axis z in 3D). The bar spans a ∈ [R − h, R + h],
+/// b ∈ [−w/2, w/2] (the part beyond the shell, a > R, is out of reach and only closes the
+/// shape) and, with end plates, z ∈ [0, L]. Clamping each coordinate to the bar gives the
+/// closest point on a face, an edge or a corner, whichever it is. `axial` is the particle's
+/// distance along z from the bar (0 when it is beside it or the mill is periodic).
+bool lifter_contact(const Mill2D& mill, int index, const Vec2& planar_centre, double axial,
+                    double particle_radius, WallContact<2>& contact) {
   const Vec2 radial = mill.lifter_direction[static_cast<std::size_t>(index)];
   const Vec2 tangential{{-radial[1], radial[0]}};
-  const double a = dot(centre, radial);
-  const double b = dot(centre, tangential);
+  const double a = dot(planar_centre, radial);
+  const double b = dot(planar_centre, tangential);
   const double inner = mill.radius - mill.lifter_height;
   const double outer = mill.radius + mill.lifter_height;
   const double half_width = 0.5 * mill.lifter_width;
@@ -26,11 +29,16 @@ bool lifter_contact(const Mill2D& mill, int index, const Vec2& centre, double pa
   double normal_b = b - closest_b;
   double point_a = closest_a;
   double point_b = closest_b;
-  const double distance = std::hypot(normal_a, normal_b);
-  if (distance > 0.0) {
-    if (distance >= particle_radius) return false;
+  // sqrt rather than hypot: no overflow is possible at mill scales, and hypot is slow.
+  const double planar_distance = std::sqrt(normal_a * normal_a + normal_b * normal_b);
+  const double distance = std::sqrt(planar_distance * planar_distance + axial * axial);
+  if (distance >= particle_radius) return false;
+  if (planar_distance > 0.0) {
+    // The in-plane part of the normal; the caller adds the axial part for an end edge.
     normal_a /= distance;
     normal_b /= distance;
+    contact.overlap = particle_radius - distance;
+  } else if (axial > 0.0) {
     contact.overlap = particle_radius - distance;
   } else {
     // Centre inside the bar (only after a violent step): push out through the nearest face.
@@ -56,6 +64,53 @@ bool lifter_contact(const Mill2D& mill, int index, const Vec2& centre, double pa
   return true;
 }
 
+/// The lifters a particle at `planar_centre` may touch: the one nearest to it by angle and
+/// that lifter's two neighbours (any lifter further round lies behind one of those). Calls
+/// visit(index) for each.
+template <typename Visit>
+void for_each_nearby_lifter(const Mill2D& mill, const Vec2& planar_centre, Visit&& visit) {
+  const double spacing = 2.0 * pi / mill.lifter_count;
+  const double relative = std::atan2(planar_centre[1], planar_centre[0]) - mill.angle;
+  const int nearest = static_cast<int>(std::lround(relative / spacing));
+  const int reach = std::min(1, (mill.lifter_count - 1) / 2);
+  const int last = mill.lifter_count == 2 ? nearest + 1 : nearest + reach;
+  for (int k = nearest - reach; k <= last; ++k) {
+    visit(((k % mill.lifter_count) + mill.lifter_count) % mill.lifter_count);
+  }
+}
+
+/// Contact with the shell, a circle (2D) or a cylinder (3D) of radius R about the z axis.
+bool shell_contact(const Mill2D& mill, const Vec2& planar_centre, double particle_radius,
+                   WallContact<2>& shell) {
+  const double distance = norm(planar_centre);
+  if (distance + particle_radius <= mill.radius || distance <= 0.0) return false;
+  const Vec2 outward = planar_centre * (1.0 / distance);
+  shell.wall_id = 0;
+  shell.kind = WallKind::shell;
+  shell.normal = -outward;
+  shell.overlap = distance + particle_radius - mill.radius;
+  shell.point = mill.radius * outward;
+  shell.wall_velocity = cross(mill.angular_speed, shell.point);
+  return true;
+}
+
+bool beyond_lifter_reach(const Mill2D& mill, const Vec2& planar_centre, double particle_radius) {
+  return mill.lifter_count == 0 ||
+         norm(planar_centre) + particle_radius <= mill.radius - mill.lifter_height;
+}
+
+/// A 3D contact from the in-plane one found on the cross-section, at height z.
+WallContact<3> extrude(const WallContact<2>& planar, double z) {
+  WallContact<3> contact;
+  contact.wall_id = planar.wall_id;
+  contact.kind = planar.kind;
+  contact.normal = Vec3{{planar.normal[0], planar.normal[1], 0.0}};
+  contact.overlap = planar.overlap;
+  contact.point = Vec3{{planar.point[0], planar.point[1], z}};
+  contact.wall_velocity = Vec3{{planar.wall_velocity[0], planar.wall_velocity[1], 0.0}};
+  return contact;
+}
+
 }  // namespace
 
 void Mill2D::turn_to(double new_angle) {
@@ -71,30 +126,48 @@ void Mill2D::turn_to(double new_angle) {
 int mill_contacts(const Mill2D& mill, const Vec2& centre, double particle_radius,
                   WallContact<2>* out) {
   int count = 0;
-  const double distance = norm(centre);
-  if (distance + particle_radius > mill.radius && distance > 0.0) {
-    WallContact<2>& shell = out[count++];
-    const Vec2 outward = centre * (1.0 / distance);
-    shell.wall_id = 0;
-    shell.kind = WallKind::shell;
-    shell.normal = -outward;
-    shell.overlap = distance + particle_radius - mill.radius;
-    shell.point = mill.radius * outward;
-    shell.wall_velocity = cross(mill.angular_speed, shell.point);
+  if (shell_contact(mill, centre, particle_radius, out[count])) ++count;
+  if (beyond_lifter_reach(mill, centre, particle_radius)) return count;
+  for_each_nearby_lifter(mill, centre, [&](int index) {
+    if (lifter_contact(mill, index, centre, 0.0, particle_radius, out[count])) ++count;
+  });
+  return count;
+}
+
+int mill_contacts(const Mill3D& mill, const Vec3& centre, double particle_radius,
+                  WallContact<3>* out) {
+  int count = 0;
+  const Vec2 planar{{centre[0], centre[1]}};
+  const double z = centre[2];
+  WallContact<2> found;
+  if (shell_contact(mill, planar, particle_radius, found)) out[count++] = extrude(found, z);
+  if (!beyond_lifter_reach(mill, planar, particle_radius)) {
+    // Beyond an end of the bars (only while a sphere presses into an end plate) the closest
+    // point is on the bar's end edge or corner, out of the plane of the centre.
+    const double bar_z = mill.periodic ? z : std::clamp(z, 0.0, mill.length);
+    const double axial = z - bar_z;
+    for_each_nearby_lifter(mill, planar, [&](int index) {
+      if (!lifter_contact(mill, index, planar, std::abs(axial), particle_radius, found)) return;
+      WallContact<3>& contact = out[count++];
+      contact = extrude(found, bar_z);
+      if (axial != 0.0) contact.normal[2] = axial / (particle_radius - found.overlap);
+    });
   }
-  if (mill.lifter_count == 0 || distance + particle_radius <= mill.radius - mill.lifter_height) {
-    return count;
-  }
-  // A disc can only reach the lifter nearest to it by angle and that lifter's two neighbours:
-  // any lifter further round lies behind one of those.
-  const double spacing = 2.0 * pi / mill.lifter_count;
-  const double relative = std::atan2(centre[1], centre[0]) - mill.angle;
-  const int nearest = static_cast<int>(std::lround(relative / spacing));
-  const int reach = std::min(1, (mill.lifter_count - 1) / 2);
-  const int last = mill.lifter_count == 2 ? nearest + 1 : nearest + reach;
-  for (int k = nearest - reach; k <= last; ++k) {
-    const int index = ((k % mill.lifter_count) + mill.lifter_count) % mill.lifter_count;
-    if (lifter_contact(mill, index, centre, particle_radius, out[count])) ++count;
+  if (!mill.periodic) {
+    // End plates: flat discs at z = 0 (normal +z) and z = L (normal −z), turning with the shell.
+    const int first_plate = 1 + mill.lifter_count;
+    for (int side = 0; side < 2; ++side) {
+      const double gap = side == 0 ? z : mill.length - z;
+      if (gap >= particle_radius) continue;
+      WallContact<3>& plate = out[count++];
+      plate.wall_id = first_plate + side;
+      plate.kind = WallKind::end_plate;
+      plate.normal = Vec3{{0.0, 0.0, side == 0 ? 1.0 : -1.0}};
+      plate.overlap = particle_radius - gap;
+      plate.point = Vec3{{centre[0], centre[1], side == 0 ? 0.0 : mill.length}};
+      const Vec2 velocity = cross(mill.angular_speed, planar);
+      plate.wall_velocity = Vec3{{velocity[0], velocity[1], 0.0}};
+    }
   }
   return count;
 }

@@ -1,20 +1,24 @@
 // The walls particles touch: a turning mill (shell and lifters) and fixed planes.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
+#include <type_traits>
 #include <vector>
 
 #include "millsim/core/vec.hpp"
 
 namespace millsim {
 
-enum class WallKind : std::uint8_t { shell, lifter, plane };
+enum class WallKind : std::uint8_t { shell, lifter, end_plate, plane };
 
 /// One particle–wall contact, as seen from the wall.
 template <int D>
 struct WallContact {
-  int wall_id = -1;  ///< 0 the shell, 1..n the lifters, then the planes
+  /// 0 the shell, 1..n the lifters, in 3D then the two end plates (n + 1 at z = 0, n + 2 at
+  /// z = length) unless the mill is periodic, then the planes
+  int wall_id = -1;
   WallKind kind = WallKind::shell;
   Vec<D> normal{};         ///< unit, from the wall into the particle
   double overlap = 0.0;    ///< m
@@ -39,6 +43,21 @@ struct Mill2D {
   void turn_to(double new_angle);
 };
 
+/// A 3D mill: the cross-section of Mill2D (shell, lifters, angle, speed) extruded along the
+/// axis z from 0 to `length`, the lifters running its full length. With end plates (flat
+/// discs at z = 0 and z = length, turning with the shell) it is a whole mill; periodic, it is
+/// an axial slab whose ends wrap round (the World does the wrapping) and has no end plates.
+struct Mill3D : Mill2D {
+  double length = 0.0;  ///< m
+  bool periodic = false;
+
+  int end_plate_count() const { return periodic ? 0 : 2; }
+};
+
+/// The mill type of each dimension.
+template <int D>
+using MillShape = std::conditional_t<D == 2, Mill2D, Mill3D>;
+
 /// An infinite plane (a line in 2D): the particle side is where (x − point)·normal > 0.
 template <int D>
 struct Plane {
@@ -48,11 +67,20 @@ struct Plane {
 
 template <int D>
 struct Walls {
-  std::optional<Mill2D> mill;
+  std::optional<MillShape<D>> mill;
   std::vector<Plane<D>> planes;
 
-  int wall_count() const {
-    return (mill ? 1 + mill->lifter_count : 0) + static_cast<int>(planes.size());
+  int mill_wall_count() const {
+    if (!mill) return 0;
+    if constexpr (D == 3) return 1 + mill->lifter_count + mill->end_plate_count();
+    return 1 + mill->lifter_count;
+  }
+  int wall_count() const { return mill_wall_count() + static_cast<int>(planes.size()); }
+  /// The kind of wall `wall_id` (as numbered in WallContact).
+  WallKind kind_of(int wall_id) const {
+    if (wall_id >= mill_wall_count()) return WallKind::plane;
+    if (wall_id == 0) return WallKind::shell;
+    return wall_id <= mill->lifter_count ? WallKind::lifter : WallKind::end_plate;
   }
   /// False when no wall can come within `margin` of the particle, however the mill turns: it
   /// then needs no wall search until it has moved `margin` (the contact search's skin).
@@ -66,15 +94,24 @@ struct Walls {
 /// Writes at most 4 contacts (shell and up to three lifters) and returns how many.
 int mill_contacts(const Mill2D& mill, const Vec2& centre, double particle_radius,
                   WallContact<2>* out);
+/// The same for a sphere in a 3D mill: the shell, up to three lifters (rectangular prisms,
+/// touched on a face, an edge or a corner, whichever is closest) and an end plate. Writes at
+/// most 5 contacts and returns how many.
+int mill_contacts(const Mill3D& mill, const Vec3& centre, double particle_radius,
+                  WallContact<3>* out);
+/// Most wall contacts one particle can have with a mill.
+template <int D>
+inline constexpr int max_mill_contacts = D == 2 ? 4 : 5;
 
 template <int D>
 bool Walls<D>::may_touch(const Vec<D>& centre, double particle_radius, double margin) const {
   const double reach = particle_radius + margin;
-  if constexpr (D == 2) {
-    if (mill) {
-      // Lifters sweep the ring between R − h and R as the mill turns.
-      const double inner = mill->radius - (mill->lifter_count > 0 ? mill->lifter_height : 0.0);
-      if (norm(centre) + reach > inner) return true;
+  if (mill) {
+    // Lifters sweep the ring between R − h and R as the mill turns.
+    const double inner = mill->radius - (mill->lifter_count > 0 ? mill->lifter_height : 0.0);
+    if (std::sqrt(centre[0] * centre[0] + centre[1] * centre[1]) + reach > inner) return true;
+    if constexpr (D == 3) {
+      if (!mill->periodic && (centre[2] < reach || centre[2] > mill->length - reach)) return true;
     }
   }
   for (const Plane<D>& plane : planes) {
@@ -87,13 +124,11 @@ template <int D>
 template <typename Emit>
 void Walls<D>::for_each_contact(const Vec<D>& centre, double particle_radius, Emit&& emit) const {
   int id_offset = 0;
-  if constexpr (D == 2) {
-    if (mill) {
-      WallContact<2> found[4];
-      const int count = mill_contacts(*mill, centre, particle_radius, found);
-      for (int k = 0; k < count; ++k) emit(found[k]);
-      id_offset = 1 + mill->lifter_count;
-    }
+  if (mill) {
+    WallContact<D> found[max_mill_contacts<D>];
+    const int count = mill_contacts(*mill, centre, particle_radius, found);
+    for (int k = 0; k < count; ++k) emit(found[k]);
+    id_offset = mill_wall_count();
   }
   for (std::size_t p = 0; p < planes.size(); ++p) {
     const Plane<D>& plane = planes[p];

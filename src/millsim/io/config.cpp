@@ -33,7 +33,7 @@ const std::vector<KnownTable>& known_tables() {
   static const std::vector<KnownTable> tables = {
       {"simulation",
        {"dimension", "time_step", "settle_time", "revolutions", "measure_revolutions", "seed"}},
-      {"mill", {"diameter", "length", "speed", "speed_rpm", "lifters"}},
+      {"mill", {"diameter", "length", "speed", "speed_rpm", "periodic", "slab_length", "lifters"}},
       {"mill.lifters", {"count", "height", "width"}},
       {"charge", {"filling", "porosity", "density", "ball_diameter", "top_size", "sizes"}},
       {"materials", {"ball_ball", "ball_wall"}},
@@ -65,13 +65,9 @@ void read_simulation(TableReader section, MillConfig& config) {
   section.allow_keys(
       {"dimension", "time_step", "settle_time", "revolutions", "measure_revolutions", "seed"},
       belongs_elsewhere);
-  config.dimension = static_cast<int>(section.integer(
-      "dimension", 2, "2 (3D comes in a later version)", [](long d) { return d == 2 || d == 3; }));
-  if (config.dimension == 3) {
-    section.fail_at("dimension",
-                    "3 (a 3D mill) is not available yet in this version; allowed: 2 (a 2D slice "
-                    "of the mill)");
-  }
+  config.dimension =
+      static_cast<int>(section.integer("dimension", 2, "2 (a slice of discs) or 3 (spheres)",
+                                       [](long d) { return d == 2 || d == 3; }));
   const std::string step_rule = "\"auto\" or a number of seconds > 0";
   if (const toml::node* step = section.node("time_step")) {
     if (step->is_string()) {
@@ -147,8 +143,37 @@ void read_lifters(TableReader lifters, MillConfig& config) {
       [&](double w) { return w > 0.0 && w < widest; });
 }
 
+/// mill.periodic and mill.slab_length: a 3D slab with periodic ends. The slab must be shorter
+/// than the mill; that it is long enough for the balls is checked with the charge.
+void read_periodic(TableReader& section, MillConfig& config) {
+  const std::string periodic_rule =
+      "true (simulate a periodic axial slab of mill.slab_length, power scaled to mill.length) or "
+      "false (the whole mill with end plates)";
+  config.periodic = section.boolean("periodic", false, periodic_rule);
+  if (config.periodic && config.dimension != 3) {
+    section.fail_at("periodic", fmt::format("true needs simulation.dimension = 3; allowed: false "
+                                            "in 2D (a 2D slice has no ends)"));
+  }
+  const std::string slab_rule =
+      fmt::format("a number of metres > 0 and at most mill.length = {} m", config.length);
+  if (!config.periodic) {
+    if (section.has("slab_length")) {
+      section.fail_at("slab_length",
+                      "is given but mill.periodic is not true; allowed: "
+                      "slab_length only with mill.periodic = true");
+    }
+    return;
+  }
+  config.slab_length =
+      section.number("slab_length", std::nullopt,
+                     fmt::format("{}; needed because mill.periodic = true", slab_rule),
+                     [&](double l) { return l > 0.0 && l <= config.length; });
+}
+
 void read_mill(TableReader section, MillConfig& config) {
-  section.allow_keys({"diameter", "length", "speed", "speed_rpm", "lifters"}, belongs_elsewhere);
+  section.allow_keys(
+      {"diameter", "length", "speed", "speed_rpm", "periodic", "slab_length", "lifters"},
+      belongs_elsewhere);
   config.diameter = section.number("diameter", std::nullopt,
                                    "a number of metres > 0 (inside the shell)", positive);
   config.length = section.number("length", std::nullopt, "a number of metres > 0", positive);
@@ -164,6 +189,7 @@ void read_mill(TableReader section, MillConfig& config) {
                                              section.location("speed"), either));
   }
   if (!config.speed_fraction && !config.speed_rpm) section.fail_missing("speed", either);
+  read_periodic(section, config);
   read_lifters(section.table("lifters", false), config);
 }
 

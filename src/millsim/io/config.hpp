@@ -45,6 +45,8 @@ struct MillConfig {
   int lifter_count = 0;
   double lifter_height = 0.0;  ///< m, radial
   double lifter_width = 0.0;   ///< m, tangential
+  bool periodic = false;       ///< 3D: simulate a periodic axial slab instead of end plates
+  double slab_length = 0.0;    ///< m, 3D periodic: the slab's length; power scales to length
 
   // [charge]
   double filling = 0.0;

@@ -38,8 +38,10 @@ std::string power_table(const std::vector<PowerInterval>& rows, bool numbered) {
 std::string spectrum_table(const MillResult& result) {
   const ImpactSpectrum& s = result.spectrum;
   const double window = result.window_end.time - result.window_start.time;
-  constexpr ContactType types[] = {ContactType::ball_ball, ContactType::ball_shell,
-                                   ContactType::ball_lifter};
+  // End plates exist only in 3D mills; a 2D file has no column for them.
+  std::vector<ContactType> types = {ContactType::ball_ball, ContactType::ball_shell,
+                                    ContactType::ball_lifter};
+  if (result.plan.config.dimension == 3) types.push_back(ContactType::ball_end_plate);
   std::string text = "energy_low_j,energy_high_j";
   for (const ContactType t : types) {
     const auto name = contact_type_name(t);
@@ -65,6 +67,25 @@ std::string spectrum_table(const MillResult& result) {
 }
 
 }  // namespace
+
+void write_snapshot(const std::filesystem::path& directory, int index, const World<3>& world) {
+  const auto path = directory / fmt::format("snapshot_{:06d}.csv", index);
+  auto out = fmt::output_file(path.string());
+  const auto& p = world.particles();
+  out.print("# time_s = {:.9g}, shell_angle_rad = {:.9g}\n", world.time(),
+            world.walls().mill ? world.walls().mill->angle : 0.0);
+  out.print("id,x,y,z,vx,vy,vz,wx,wy,wz,radius,fx,fy,fz\n");
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Vec3& x = p.position[i];
+    const Vec3& v = p.velocity[i];
+    const Vec3& w = p.angular_velocity[i];
+    const Vec3& f = p.force[i];
+    out.print(
+        "{},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},"
+        "{:.7g},{:.7g}\n",
+        i, x[0], x[1], x[2], v[0], v[1], v[2], w[0], w[1], w[2], p.radius[i], f[0], f[1], f[2]);
+  }
+}
 
 void write_snapshot(const std::filesystem::path& directory, int index, const World<2>& world) {
   const auto path = directory / fmt::format("snapshot_{:06d}.csv", index);
@@ -111,7 +132,8 @@ std::string summary_json(const MillResult& r) {
       {"power_scale", plan.power_scale},
       {"charge_centre_of_mass_m", toml::array{r.charge_centre[0], r.charge_centre[1]}},
       {"charge_orbital_speed_ratio", r.orbital_speed_ratio},
-      {"discs", discs},
+      {c.dimension == 2 ? "discs" : "balls", discs},
+      {"dimension", c.dimension},
   };
   if (c.reference) {
     toml::table reference{{"case", c.reference->case_name},
@@ -128,9 +150,10 @@ std::string summary_json(const MillResult& r) {
 std::string summary_line(const MillResult& r) {
   return fmt::format(
       "power {:.4g} kW (dissipation {:.4g} kW, ±{:.2g} kW between revolutions) at {:.3g} rpm "
-      "({:.0f}% of critical); {} discs, {} steps in {:.1f} s ({:.3g} particle-steps/s)",
+      "({:.0f}% of critical); {} {}, {} steps in {:.1f} s ({:.3g} particle-steps/s)",
       r.power_kw, r.power_dissipation_kw, r.power_std_kw, r.plan.speed_rpm,
-      100.0 * r.plan.speed_fraction, r.plan.particle_count, r.steps, r.wall_seconds,
+      100.0 * r.plan.speed_fraction, r.plan.particle_count,
+      r.plan.config.dimension == 2 ? "discs" : "balls", r.steps, r.wall_seconds,
       r.particle_steps_per_second);
 }
 

@@ -13,6 +13,7 @@ struct MillResult;
 /// snapshots/snapshot_NNNNNN.csv: time, and per particle id, position, velocity, angular
 /// velocity, radius and net force.
 void write_snapshot(const std::filesystem::path& directory, int index, const World<2>& world);
+void write_snapshot(const std::filesystem::path& directory, int index, const World<3>& world);
 
 /// summary.json, power.csv, power_timeseries.csv and spectrum.csv. summary.json is written
 /// last, so its presence means the run finished.

@@ -321,6 +321,13 @@ long TableReader::integer(std::string_view key, std::optional<long> fallback,
   return value;
 }
 
+bool TableReader::boolean(std::string_view key, bool fallback, std::string_view allowed) {
+  const toml::node* n = node(key);
+  if (n == nullptr) return fallback;
+  if (const auto* b = n->as_boolean()) return b->get();
+  fail_at(key, fmt::format("{}; allowed: {}", wrong_type(*n), allowed));
+}
+
 std::string TableReader::string(std::string_view key, std::optional<std::string> fallback,
                                 std::string_view allowed) {
   const toml::node* n = node(key);

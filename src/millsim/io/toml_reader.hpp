@@ -64,6 +64,7 @@ class TableReader {
                const std::function<bool(long)>& valid);
   /// A string. A value given with --set is taken as the text typed even when it reads as
   /// another TOML value (--set output.directory=2024 names the directory "2024").
+  bool boolean(std::string_view key, bool fallback, std::string_view allowed);
   std::string string(std::string_view key, std::optional<std::string> fallback,
                      std::string_view allowed);
   /// The sub-table `key`: an empty one if absent and not required. `allowed` describes the

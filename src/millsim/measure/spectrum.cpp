@@ -14,6 +14,8 @@ std::string_view contact_type_name(ContactType type) {
       return "ball_shell";
     case ContactType::ball_lifter:
       return "ball_lifter";
+    case ContactType::ball_end_plate:
+      return "ball_end_plate";
     case ContactType::ball_plane:
       return "ball_plane";
   }

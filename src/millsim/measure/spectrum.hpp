@@ -9,8 +9,8 @@
 
 namespace millsim {
 
-enum class ContactType { ball_ball, ball_shell, ball_lifter, ball_plane };
-inline constexpr std::size_t contact_type_count = 4;
+enum class ContactType { ball_ball, ball_shell, ball_lifter, ball_end_plate, ball_plane };
+inline constexpr std::size_t contact_type_count = 5;
 std::string_view contact_type_name(ContactType type);
 
 class ImpactSpectrum {

@@ -11,7 +11,7 @@ bool NeighbourList<D>::needs_refresh(const std::vector<Vec<D>>& position) const 
   if (position.size() != reference_position_.size()) return true;
   const double limit = 0.25 * skin_ * skin_;  // (skin / 2)²
   for (std::size_t i = 0; i < position.size(); ++i) {
-    if (norm_squared(position[i] - reference_position_[i]) > limit) return true;
+    if (norm_squared(separation(reference_position_[i], position[i])) > limit) return true;
   }
   return false;
 }
@@ -24,10 +24,12 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
   next_first_.clear();
   next_second_.clear();
   if (count > 0) {
-    // Cells of side at least the largest cut-off distance, so every listed pair lies in
-    // neighbouring cells. Grow the cells if the particles are spread so wide that the grid
-    // would hold many more cells than particles.
-    const double largest_radius = *std::max_element(radius.begin(), radius.end());
+    // Cells of side the smallest cut-off distance (two of the smallest particles), grown if
+    // the particles are spread so wide that the grid would hold many more cells than
+    // particles. Each pair is found once, from its larger particle (ties: from the lower
+    // index), which searches as many cells round its own as its largest cut-off needs: a
+    // small particle looks only at its neighbouring cells however large the largest one is.
+    const auto [smallest, largest] = std::minmax_element(radius.begin(), radius.end());
     Vec<D> low = position[0];
     Vec<D> high = position[0];
     for (const Vec<D>& x : position) {
@@ -36,26 +38,41 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
         high[a] = std::max(high[a], x[a]);
       }
     }
-    double cell = 2.0 * largest_radius + skin_;
-    std::array<std::size_t, D> cells{};
+    const bool periodic = period_ > 0.0;
+    if (periodic) {
+      low[D - 1] = 0.0;
+      high[D - 1] = period_;
+    }
+    double cell = 2.0 * *smallest + skin_;
+    std::array<long, D> cells{};
+    std::array<double, D> side{};
     std::size_t total = 1;
     for (;;) {
       total = 1;
       for (int a = 0; a < D; ++a) {
-        cells[a] = static_cast<std::size_t>((high[a] - low[a]) / cell) + 1;
-        total *= cells[a];
+        side[a] = cell;
+        cells[a] = static_cast<long>((high[a] - low[a]) / cell) + 1;
+        if (a == D - 1 && periodic) {
+          // Along a periodic axis the cells tile the period exactly, each at least `cell`.
+          cells[a] = std::max(1L, static_cast<long>(period_ / cell));
+          side[a] = period_ / static_cast<double>(cells[a]);
+        }
+        total *= static_cast<std::size_t>(cells[a]);
       }
-      if (total <= 4 * count + 64) break;
+      if (total <= 32 * count + 4096) break;
       cell *= 2.0;
     }
     // Counting sort of the particles into cells.
     particle_cell_.resize(count);
     cell_start_.assign(total + 1, 0);
+    std::vector<std::array<long, D>>& home = particle_home_;
+    home.resize(count);
     for (std::size_t i = 0; i < count; ++i) {
       std::size_t index = 0;
       for (int a = D - 1; a >= 0; --a) {
-        const auto c = static_cast<std::size_t>((position[i][a] - low[a]) / cell);
-        index = index * cells[a] + std::min(c, cells[a] - 1);
+        const auto c = static_cast<long>(std::max(0.0, position[i][a] - low[a]) / side[a]);
+        home[i][a] = std::min(c, cells[a] - 1);
+        index = index * static_cast<std::size_t>(cells[a]) + static_cast<std::size_t>(home[i][a]);
       }
       particle_cell_[i] = static_cast<std::uint32_t>(index);
       ++cell_start_[index + 1];
@@ -66,37 +83,73 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
     for (std::size_t i = 0; i < count; ++i) {
       cell_members_[cell_cursor_[particle_cell_[i]]++] = static_cast<std::uint32_t>(i);
     }
-    // For each particle, the later particles within reach in the 3^D surrounding cells.
-    for (std::size_t i = 0; i < count; ++i) {
-      std::array<long, D> home{};
-      std::size_t rest = particle_cell_[i];
+
+    found_.clear();
+    // Particles in cell order, so that neighbouring searches touch neighbouring memory.
+    for (const std::uint32_t member : cell_members_) {
+      const std::size_t i = member;
+      const double cutoff = 2.0 * radius[i] + skin_;  // the farthest a smaller partner can be
+      std::array<long, D> from{};
+      std::array<long, D> to{};
       for (int a = 0; a < D; ++a) {
-        home[a] = static_cast<long>(rest % cells[a]);
-        rest /= cells[a];
-      }
-      const std::size_t begin = next_second_.size();
-      constexpr int neighbourhood = D == 2 ? 9 : 27;
-      for (int offset = 0; offset < neighbourhood; ++offset) {
-        std::size_t index = 0;
-        bool inside = true;
-        int code = offset;
-        std::array<long, D> at{};
-        for (int a = 0; a < D; ++a) {
-          at[a] = home[a] + (code % 3) - 1;
-          code /= 3;
-          inside = inside && at[a] >= 0 && at[a] < static_cast<long>(cells[a]);
+        const long range = static_cast<long>(std::ceil(cutoff / side[a]));
+        from[a] = home[i][a] - range;
+        to[a] = home[i][a] + range;
+        if (periodic && a == D - 1 && to[a] - from[a] + 1 >= cells[a]) {
+          from[a] = 0;  // the range wraps onto itself: visit every cell along the axis once
+          to[a] = cells[a] - 1;
+        } else if (!(periodic && a == D - 1)) {
+          from[a] = std::max(0L, from[a]);
+          to[a] = std::min(cells[a] - 1, to[a]);
         }
-        if (!inside) continue;
-        for (int a = D - 1; a >= 0; --a) index = index * cells[a] + static_cast<std::size_t>(at[a]);
-        for (std::uint32_t k = cell_start_[index]; k < cell_start_[index + 1]; ++k) {
+      }
+      // Cells along axis 0 are contiguous in the cell order, so each row of the range is one
+      // run of cell_members_ (axis 0 is never periodic).
+      const auto visit_row = [&](std::size_t row) {
+        const std::uint32_t begin = cell_start_[row + static_cast<std::size_t>(from[0])];
+        const std::uint32_t end = cell_start_[row + static_cast<std::size_t>(to[0]) + 1];
+        for (std::uint32_t k = begin; k < end; ++k) {
           const std::uint32_t j = cell_members_[k];
-          if (j <= i) continue;
+          if (radius[j] > radius[i] || (radius[j] == radius[i] && j <= i)) continue;
           const double reach = radius[i] + radius[j] + skin_;
-          if (norm_squared(position[j] - position[i]) < reach * reach) next_second_.push_back(j);
+          if (norm_squared(separation(position[i], position[j])) < reach * reach) {
+            const auto self = static_cast<std::uint32_t>(i);
+            found_.push_back(self < j ? std::pair{self, j} : std::pair{j, self});
+          }
+        }
+      };
+      const auto wrap = [&](long c, int a) {
+        return c < 0 ? c + cells[a] : (c >= cells[a] ? c - cells[a] : c);
+      };
+      const auto width = static_cast<std::size_t>(cells[0]);
+      if constexpr (D == 2) {
+        for (long y = from[1]; y <= to[1]; ++y) visit_row(static_cast<std::size_t>(y) * width);
+      } else {
+        for (long z = from[2]; z <= to[2]; ++z) {
+          const auto plane =
+              static_cast<std::size_t>(wrap(z, 2)) * static_cast<std::size_t>(cells[1]);
+          for (long y = from[1]; y <= to[1]; ++y) {
+            visit_row((plane + static_cast<std::size_t>(y)) * width);
+          }
         }
       }
-      std::sort(next_second_.begin() + static_cast<long>(begin), next_second_.end());
-      next_first_.resize(next_second_.size(), static_cast<std::uint32_t>(i));
+    }
+    // Sorted by (first, second): a counting sort by first, then each first's seconds.
+    pair_cursor_.assign(count + 1, 0);
+    for (const auto& pair : found_) ++pair_cursor_[pair.first + 1];
+    for (std::size_t i = 0; i < count; ++i) pair_cursor_[i + 1] += pair_cursor_[i];
+    next_first_.resize(found_.size());
+    next_second_.resize(found_.size());
+    for (const auto& [a, b] : found_) {
+      const std::uint32_t slot = pair_cursor_[a]++;
+      next_first_[slot] = a;
+      next_second_[slot] = b;
+    }
+    std::uint32_t begin = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::uint32_t end = pair_cursor_[i];
+      std::sort(next_second_.begin() + begin, next_second_.begin() + end);
+      begin = end;
     }
   }
   // Carry the history of pairs kept from the old list: both lists are sorted by (first, second).

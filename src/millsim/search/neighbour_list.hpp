@@ -3,7 +3,10 @@
 // every pair (its springs, its dissipated energy) is carried over when the list is rebuilt.
 #pragma once
 
+#include <array>
+#include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "millsim/contact/contact.hpp"
@@ -16,6 +19,18 @@ class NeighbourList {
  public:
   /// skin: extra distance beyond contact within which pairs are listed, m (> 0).
   explicit NeighbourList(double skin) : skin_(skin) {}
+
+  /// Makes the last axis periodic with this period, m (0: not periodic). Positions along it
+  /// must lie in [0, period), and the period must exceed twice the largest cut-off distance
+  /// so that a particle meets at most one image of another.
+  void set_period(double period) { period_ = period; }
+  double period() const { return period_; }
+  /// b − a, along the periodic axis the nearest image's.
+  Vec<D> separation(const Vec<D>& a, const Vec<D>& b) const {
+    Vec<D> offset = b - a;
+    if (period_ > 0.0) offset[D - 1] -= period_ * std::nearbyint(offset[D - 1] / period_);
+    return offset;
+  }
 
   /// True when a particle has moved more than half the skin since the last rebuild (or the
   /// particle count changed): only then can a pair not in the list have come into contact.
@@ -41,6 +56,7 @@ class NeighbourList {
 
  private:
   double skin_;
+  double period_ = 0.0;
   long rebuild_count_ = 0;
   std::vector<std::uint32_t> first_, second_;
   std::vector<ContactHistory<D>> history_;
@@ -49,6 +65,9 @@ class NeighbourList {
   // Scratch kept between rebuilds so that a rebuild allocates nothing in steady state.
   std::vector<std::uint32_t> particle_cell_, cell_start_, cell_cursor_, cell_members_;
   std::vector<std::uint32_t> next_first_, next_second_;
+  std::vector<std::array<long, D>> particle_home_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> found_;
+  std::vector<std::uint32_t> pair_cursor_;
   std::vector<ContactHistory<D>> next_history_;
 };
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -16,10 +17,12 @@ double sphere_mass(double diameter, double density) {
   return density * pi / 6.0 * diameter * diameter * diameter;
 }
 
-/// True when a disc at `centre` lies inside the shell and clear of every lifter.
-bool clear_of_walls(const Mill2D& mill, const Vec2& centre, double radius) {
-  WallContact<2> found[4];
-  // A small margin so that no disc starts touching a wall.
+/// True when a ball at `centre` lies inside the shell and clear of every lifter (and end
+/// plate).
+template <int D>
+bool clear_of_walls(const MillShape<D>& mill, const Vec<D>& centre, double radius) {
+  WallContact<D> found[max_mill_contacts<D>];
+  // A small margin so that no ball starts touching a wall.
   return mill_contacts(mill, centre, radius * 1.02, found) == 0;
 }
 
@@ -44,37 +47,60 @@ MillPlan plan_mill(const MillConfig& config) {
   plan.angular_speed = plan.speed_rpm * 2.0 * pi / 60.0;
   plan.revolution_period = 60.0 / plan.speed_rpm;
 
-  // Discs: the bed fills J of the slice with a 2D void fraction; each size class takes its
-  // mass fraction of the disc area (a section through a 3D charge shows each size with its
-  // volume fraction).
-  const double slice_area = pi * plan.radius * plan.radius;
-  const double disc_area = config.filling * slice_area * (1.0 - disc_bed_porosity);
-  for (const SizeClass& s : config.sizes) {
-    DiscClass c;
-    c.diameter = s.diameter;
-    c.mass = sphere_mass(s.diameter, config.density);
-    const double one = pi / 4.0 * s.diameter * s.diameter;
-    c.count = std::max(1, static_cast<int>(std::lround(s.mass_fraction * disc_area / one)));
-    plan.particle_count += c.count;
-    plan.slice_mass += c.count * c.mass;
-    plan.discs.push_back(c);
+  if (config.periodic && config.slab_length < 3.0 * plan.largest_ball) {
+    // A ball must not meet two images of another across the period.
+    throw InputError(fmt::format(
+        "{}: mill.slab_length: {} m is too short for balls of {} m; allowed: at least three "
+        "largest ball diameters, {} m, and at most mill.length",
+        config.location_of("mill.slab_length"), config.slab_length, plan.largest_ball,
+        3.0 * plan.largest_ball));
+  }
+  const double cross_section = pi * plan.radius * plan.radius;
+  plan.mill_charge_mass =
+      config.density * (1.0 - config.porosity) * config.filling * cross_section * config.length;
+  if (config.dimension == 2) {
+    // Discs: the bed fills J of the slice with a 2D void fraction; each size class takes its
+    // mass fraction of the disc area (a section through a 3D charge shows each size with its
+    // volume fraction).
+    const double disc_area = config.filling * cross_section * (1.0 - disc_bed_porosity);
+    for (const SizeClass& s : config.sizes) {
+      const double one = pi / 4.0 * s.diameter * s.diameter;
+      plan.discs.push_back(
+          {s.diameter, sphere_mass(s.diameter, config.density),
+           std::max(1, static_cast<int>(std::lround(s.mass_fraction * disc_area / one)))});
+    }
+  } else {
+    // Spheres: the simulated length holds its share of the real charge, ρ (1 − porosity) J
+    // π R² L, each size class its mass fraction of it.
+    plan.simulated_length = config.periodic ? config.slab_length : config.length;
+    const double charge_mass = plan.mill_charge_mass * plan.simulated_length / config.length;
+    for (const SizeClass& s : config.sizes) {
+      const double one = sphere_mass(s.diameter, config.density);
+      plan.discs.push_back(
+          {s.diameter, one,
+           std::max(1, static_cast<int>(std::lround(s.mass_fraction * charge_mass / one)))});
+    }
   }
   std::sort(plan.discs.begin(), plan.discs.end(),
             [](const DiscClass& a, const DiscClass& b) { return a.diameter > b.diameter; });
-  plan.mill_charge_mass =
-      config.density * (1.0 - config.porosity) * config.filling * slice_area * config.length;
-  plan.power_scale = plan.mill_charge_mass / plan.slice_mass;
+  for (const DiscClass& c : plan.discs) {
+    plan.particle_count += c.count;
+    plan.slice_mass += c.count * c.mass;
+  }
+  // 2D: a slice scaled by charge mass (docs/model.md). 3D: the mill itself, or a periodic
+  // slab scaled by length.
+  plan.power_scale = config.dimension == 2 ? plan.mill_charge_mass / plan.slice_mass
+                                           : config.length / plan.simulated_length;
 
   // Time step from the lightest contacts: two of the smallest discs, and one against a wall.
   const double lightest = plan.discs.back().mass;
   const double pair_mass = reduced_mass(lightest, lightest);
   plan.contact_duration_ball_ball = contact_duration(config.ball_ball, pair_mass);
   plan.contact_duration_ball_wall = contact_duration(config.ball_wall, lightest);
-  constexpr double disc_inertia = 0.5;
+  const double inertia = config.dimension == 2 ? inertia_factor<2> : inertia_factor<3>;
   plan.critical_time_step = std::min(
-      critical_time_step(config.ball_ball, pair_mass,
-                         tangential_mass(lightest, lightest, disc_inertia)),
-      critical_time_step(config.ball_wall, lightest, tangential_mass(lightest, 0.0, disc_inertia)));
+      critical_time_step(config.ball_ball, pair_mass, tangential_mass(lightest, lightest, inertia)),
+      critical_time_step(config.ball_wall, lightest, tangential_mass(lightest, 0.0, inertia)));
   const double accurate =
       std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall) /
       steps_per_contact;
@@ -95,70 +121,113 @@ MillPlan plan_mill(const MillConfig& config) {
   return plan;
 }
 
-World<2> build_mill_world(const MillPlan& plan) {
+template <int D>
+World<D> build_mill_world(const MillPlan& plan) {
   const MillConfig& config = plan.config;
-  WorldSettings<2> settings;
+  WorldSettings<D> settings;
   settings.time_step = plan.time_step;
-  settings.gravity = Vec2{{0.0, -standard_gravity}};
+  settings.gravity[1] = -standard_gravity;
   settings.ball_ball = config.ball_ball;
   settings.ball_wall = config.ball_wall;
-  Walls<2> walls;
-  Mill2D mill;
+  Walls<D> walls;
+  MillShape<D> mill;
   mill.radius = plan.radius;
   mill.lifter_count = config.lifter_count;
   mill.lifter_height = config.lifter_height;
   mill.lifter_width = config.lifter_width;
+  if constexpr (D == 3) {
+    mill.length = plan.simulated_length;
+    mill.periodic = config.periodic;
+  }
   mill.turn_to(0.0);
   walls.mill = mill;
-  World<2> world(settings, walls);
+  World<D> world(settings, walls);
 
-  // Random sequential placement, largest first, checked against a grid of cells one largest
-  // diameter wide.
+  // Random sequential placement, largest first, anywhere in the free space of the mill,
+  // checked against a grid of cells one largest diameter wide. Along a periodic axis, cells
+  // and distances wrap round.
   std::mt19937_64 random(config.seed);
-  std::uniform_real_distribution<double> uniform(-plan.radius, plan.radius);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const double cell = plan.largest_ball;
-  const int cells = static_cast<int>(std::ceil(2.0 * plan.radius / cell)) + 1;
-  std::vector<std::vector<std::size_t>> grid(static_cast<std::size_t>(cells * cells));
-  const auto cell_of = [&](double coordinate) {
-    return std::clamp(static_cast<int>((coordinate + plan.radius) / cell), 0, cells - 1);
+  std::array<int, D> cells{};
+  std::array<double, D> low{};
+  std::array<double, D> span{};
+  for (int a = 0; a < D; ++a) {
+    low[a] = a < 2 ? -plan.radius : 0.0;
+    span[a] = a < 2 ? 2.0 * plan.radius : plan.simulated_length;
+    cells[a] = static_cast<int>(std::ceil(span[a] / cell)) + 1;
+  }
+  const bool periodic = D == 3 && config.periodic;
+  if (periodic) cells[D - 1] = std::max(1, static_cast<int>(span[D - 1] / cell));
+  const double period = periodic ? span[D - 1] : 0.0;
+  std::array<double, D> side{};
+  for (int a = 0; a < D; ++a) side[a] = cell;
+  if (periodic) side[D - 1] = period / cells[D - 1];
+  int total = 1;
+  for (int a = 0; a < D; ++a) total *= cells[a];
+  std::vector<std::vector<std::size_t>> grid(static_cast<std::size_t>(total));
+  const auto cell_index = [&](const std::array<int, D>& at) {
+    int index = 0;
+    for (int a = 0; a < D; ++a) index = index * cells[a] + at[a];
+    return static_cast<std::size_t>(index);
+  };
+  const auto separation = [&](const Vec<D>& from, const Vec<D>& to) {
+    Vec<D> offset = to - from;
+    if (periodic) offset[D - 1] -= period * std::nearbyint(offset[D - 1] / period);
+    return offset;
   };
   auto& particles = world.particles();
-  constexpr long attempts_per_disc = 200000;
+  const auto overlaps_another = [&](const Vec<D>& at, double r, const std::array<int, D>& home) {
+    constexpr int neighbourhood = D == 2 ? 9 : 27;
+    std::vector<std::size_t> visited;
+    for (int code = 0; code < neighbourhood; ++code) {
+      std::array<int, D> near{};
+      bool inside = true;
+      for (int a = 0, rest = code; a < D; ++a, rest /= 3) {
+        near[a] = home[a] + rest % 3 - 1;
+        if (periodic && a == D - 1) near[a] = (near[a] + cells[a]) % cells[a];
+        inside = inside && near[a] >= 0 && near[a] < cells[a];
+      }
+      if (!inside) continue;
+      const std::size_t index = cell_index(near);
+      if (std::find(visited.begin(), visited.end(), index) != visited.end()) continue;
+      visited.push_back(index);
+      for (const std::size_t other : grid[index]) {
+        const double reach = 1.01 * (r + particles.radius[other]);
+        if (norm_squared(separation(particles.position[other], at)) < reach * reach) return true;
+      }
+    }
+    return false;
+  };
+  constexpr long attempts_per_ball = 200000;
   for (const DiscClass& c : plan.discs) {
     const double r = 0.5 * c.diameter;
     for (int n = 0; n < c.count; ++n) {
       bool placed = false;
-      for (long attempt = 0; attempt < attempts_per_disc && !placed; ++attempt) {
-        const Vec2 at{{uniform(random), uniform(random)}};
-        if (!clear_of_walls(mill, at, r)) continue;
-        const int cx = cell_of(at[0]);
-        const int cy = cell_of(at[1]);
-        bool free = true;
-        for (int gx = std::max(0, cx - 1); gx <= std::min(cells - 1, cx + 1) && free; ++gx) {
-          for (int gy = std::max(0, cy - 1); gy <= std::min(cells - 1, cy + 1) && free; ++gy) {
-            for (const std::size_t other : grid[static_cast<std::size_t>(gx * cells + gy)]) {
-              const double reach = 1.01 * (r + particles.radius[other]);
-              if (norm_squared(particles.position[other] - at) < reach * reach) {
-                free = false;
-                break;
-              }
-            }
-          }
+      for (long attempt = 0; attempt < attempts_per_ball && !placed; ++attempt) {
+        Vec<D> at{};
+        std::array<int, D> home{};
+        for (int a = 0; a < D; ++a) {
+          at[a] = low[a] + span[a] * uniform(random);
+          home[a] = std::clamp(static_cast<int>((at[a] - low[a]) / side[a]), 0, cells[a] - 1);
         }
-        if (!free) continue;
-        grid[static_cast<std::size_t>(cx * cells + cy)].push_back(particles.add(at, r, c.mass));
+        if (!clear_of_walls(mill, at, r) || overlaps_another(at, r, home)) continue;
+        grid[cell_index(home)].push_back(particles.add(at, r, c.mass));
         placed = true;
       }
       if (!placed) {
         throw InputError(fmt::format(
-            "{}: charge.filling: could not place {} discs of {} m without overlap in the mill "
+            "{}: charge.filling: could not place {} {} of {} m without overlap in the mill "
             "(placed {}); lower the filling or use smaller balls",
-            config.location_of("charge.filling"), plan.particle_count, c.diameter,
-            particles.size()));
+            config.location_of("charge.filling"), plan.particle_count, D == 2 ? "discs" : "balls",
+            c.diameter, particles.size()));
       }
     }
   }
   return world;
 }
+
+template World<2> build_mill_world<2>(const MillPlan&);
+template World<3> build_mill_world<3>(const MillPlan&);
 
 }  // namespace millsim

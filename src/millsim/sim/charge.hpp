@@ -15,6 +15,7 @@ inline constexpr double disc_bed_porosity = 0.2;
 /// Default steps per contact duration of the stiffest, lightest pair ("auto" time step).
 inline constexpr double steps_per_contact = 20.0;
 
+/// One size of the simulated charge: discs in 2D, spheres in 3D.
 struct DiscClass {
   double diameter = 0.0;  ///< m
   double mass = 0.0;      ///< kg: the mass of the sphere of that diameter
@@ -33,9 +34,12 @@ struct MillPlan {
   double revolution_period = 0.0;  ///< s
   std::vector<DiscClass> discs;
   int particle_count = 0;
-  double slice_mass = 0.0;                  ///< kg, the simulated discs
-  double mill_charge_mass = 0.0;            ///< kg, ρ (1 − porosity) J π R² L
-  double power_scale = 0.0;                 ///< mill_charge_mass / slice_mass
+  double slice_mass = 0.0;        ///< kg, the simulated discs or balls
+  double mill_charge_mass = 0.0;  ///< kg, ρ (1 − porosity) J π R² L
+  /// Simulated power × power_scale = the mill's: mill_charge_mass / slice_mass in 2D,
+  /// length / simulated_length in 3D (1 for a whole mill).
+  double power_scale = 0.0;
+  double simulated_length = 0.0;            ///< m, 3D: the mill length or the periodic slab
   double contact_duration_ball_ball = 0.0;  ///< s, smallest pair
   double contact_duration_ball_wall = 0.0;  ///< s, smallest ball
   double critical_time_step = 0.0;          ///< s, stability limit
@@ -50,6 +54,10 @@ MillPlan plan_mill(const MillConfig& config);
 /// The World for a plan, with the shell still and the charge placed without overlaps at random
 /// (largest discs first) in the free space of the mill. Throws InputError when the discs do
 /// not fit.
-World<2> build_mill_world(const MillPlan& plan);
+template <int D>
+World<D> build_mill_world(const MillPlan& plan);
+
+extern template World<2> build_mill_world<2>(const MillPlan&);
+extern template World<3> build_mill_world<3>(const MillPlan&);
 
 }  // namespace millsim

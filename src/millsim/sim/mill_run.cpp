@@ -9,7 +9,8 @@
 namespace millsim {
 namespace {
 
-EnergySample sample(const World<2>& world) {
+template <int D>
+EnergySample sample(const World<D>& world) {
   EnergySample s;
   s.time = world.time();
   s.shell_work = world.energy_account().shell_work;
@@ -33,17 +34,21 @@ PowerInterval interval(const EnergySample& from, const EnergySample& to, double 
   return p;
 }
 
-/// Centre of mass of the particles and their mean angular speed about the origin.
-std::pair<Vec2, double> charge_motion(const World<2>& world) {
+/// Centre of mass of the particles in the cross-section (x, y) and their mean angular speed
+/// about the mill axis.
+template <int D>
+std::pair<Vec2, double> charge_motion(const World<D>& world) {
   const auto& p = world.particles();
   Vec2 moment{};
   double mass = 0.0;
   double angular_speed = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    moment += p.mass[i] * p.position[i];
+    const Vec2 at{{p.position[i][0], p.position[i][1]}};
+    const Vec2 velocity{{p.velocity[i][0], p.velocity[i][1]}};
+    moment += p.mass[i] * at;
     mass += p.mass[i];
-    const double r2 = norm_squared(p.position[i]);
-    if (r2 > 0.0) angular_speed += cross(p.position[i], p.velocity[i]) / r2;
+    const double r2 = norm_squared(at);
+    if (r2 > 0.0) angular_speed += cross(at, velocity) / r2;
   }
   return {moment * (1.0 / mass), angular_speed / static_cast<double>(p.size())};
 }
@@ -54,7 +59,8 @@ double spin_up_time(const MillPlan& plan) {
   return 0.25 * plan.revolution_period;
 }
 
-MillResult run_mill(const MillPlan& plan, World<2> world,
+template <int D>
+MillResult run_mill(const MillPlan& plan, World<D> world,
                     const std::filesystem::path& snapshot_directory,
                     const ProgressCallback& progress) {
   const auto started = std::chrono::steady_clock::now();
@@ -87,7 +93,7 @@ MillResult run_mill(const MillPlan& plan, World<2> world,
 
   // Turn: ω ramps up linearly over spin_up_time, then stays. Revolutions are counted by the
   // angle the shell has turned.
-  Mill2D& mill = *world.walls().mill;
+  auto& mill = *world.walls().mill;
   const double start_angle = mill.angle;
   const double rotation_start = world.time();
   EnergySample revolution_start = sample(world);
@@ -179,5 +185,10 @@ MillResult run_mill(const MillPlan& plan, World<2> world,
       static_cast<double>(result.steps) * plan.particle_count / result.wall_seconds;
   return result;
 }
+
+template MillResult run_mill<2>(const MillPlan&, World<2>, const std::filesystem::path&,
+                                const ProgressCallback&);
+template MillResult run_mill<3>(const MillPlan&, World<3>, const std::filesystem::path&,
+                                const ProgressCallback&);
 
 }  // namespace millsim

@@ -48,7 +48,8 @@ struct MillResult {
   double wall_seconds = 0.0;
   double particle_steps_per_second = 0.0;
   double settled_kinetic_energy = 0.0;  ///< J, slice, at the end of settling
-  /// Centre of mass of the charge averaged over the measured window, m from the mill axis. Its
+  /// Centre of mass of the charge in the cross-section (x, y) averaged over the measured
+  /// window, m from the mill axis. Its
   /// horizontal offset times the charge weight is the torque that holds the charge up.
   Vec2 charge_centre{};
   /// Mean over the window and the balls of their angular speed about the mill axis divided by
@@ -61,9 +62,15 @@ using ProgressCallback = std::function<void(double, double, double)>;
 
 /// Runs the job on `world` (from build_mill_world(plan)). Snapshots go to
 /// `snapshot_directory` if the plan asks for them (it must exist). Everything else is returned.
-MillResult run_mill(const MillPlan& plan, World<2> world,
+template <int D>
+MillResult run_mill(const MillPlan& plan, World<D> world,
                     const std::filesystem::path& snapshot_directory,
                     const ProgressCallback& progress = {});
+
+extern template MillResult run_mill<2>(const MillPlan&, World<2>, const std::filesystem::path&,
+                                       const ProgressCallback&);
+extern template MillResult run_mill<3>(const MillPlan&, World<3>, const std::filesystem::path&,
+                                       const ProgressCallback&);
 
 /// Time for the shell to come up to speed: a quarter of a revolution at full speed.
 double spin_up_time(const MillPlan& plan);

@@ -11,6 +11,8 @@ ContactType wall_contact_type(WallKind kind) {
       return ContactType::ball_shell;
     case WallKind::lifter:
       return ContactType::ball_lifter;
+    case WallKind::end_plate:
+      return ContactType::ball_end_plate;
     case WallKind::plane:
       return ContactType::ball_plane;
   }
@@ -29,11 +31,12 @@ std::size_t block_count(std::size_t items, std::size_t block) {
 
 }  // namespace
 
-template <int D>
-WallKind World<D>::wall_kind(int wall_id) const {
-  if (walls_.mill && wall_id == 0) return WallKind::shell;
-  if (walls_.mill && wall_id <= walls_.mill->lifter_count) return WallKind::lifter;
-  return WallKind::plane;
+/// The moment about the mill axis (+z) of a force applied at a point.
+double axial_moment(const Vec2& point, const Vec2& force) {
+  return cross(point, force);
+}
+double axial_moment(const Vec3& point, const Vec3& force) {
+  return point[0] * force[1] - point[1] * force[0];
 }
 
 template <int D>
@@ -44,6 +47,15 @@ World<D>::World(const WorldSettings<D>& settings, const Walls<D>& walls)
       ball_wall_law_(settings.ball_wall, settings.allow_tension),
       neighbours_(settings.skin) {
   if (walls_.mill) walls_.mill->turn_to(walls_.mill->angle);
+  neighbours_.set_period(axial_period());
+}
+
+template <int D>
+double World<D>::axial_period() const {
+  if constexpr (D == 3) {
+    if (walls_.mill && walls_.mill->periodic) return walls_.mill->length;
+  }
+  return 0.0;
 }
 
 template <int D>
@@ -71,6 +83,7 @@ void World<D>::refresh_neighbours() {
     const double smallest = *std::min_element(particles_.radius.begin(), particles_.radius.end());
     settings_.skin = smallest;
     neighbours_ = NeighbourList<D>(settings_.skin);
+    neighbours_.set_period(axial_period());
   }
   neighbours_.rebuild(particles_.position, particles_.radius);
   const std::size_t pairs = neighbours_.pair_count();
@@ -94,7 +107,7 @@ void World<D>::refresh_neighbours() {
     for (std::size_t slot = i * max_wall_contacts; slot < (i + 1) * max_wall_contacts; ++slot) {
       if (wall_slot_id_[slot] < 0) continue;
       if (spectrum_ != nullptr) {
-        spectrum_->record(wall_contact_type(wall_kind(wall_slot_id_[slot])),
+        spectrum_->record(wall_contact_type(walls_.kind_of(wall_slot_id_[slot])),
                           wall_slot_history_[slot].dissipated);
       }
       wall_slot_id_[slot] = -1;
@@ -159,7 +172,7 @@ void World<D>::evaluate_pair_contacts() {
     for (std::size_t p = b * pair_block; p < end; ++p) {
       const std::uint32_t i = first[p];
       const std::uint32_t j = second[p];
-      const Vec<D> offset = x[j] - x[i];
+      const Vec<D> offset = neighbours_.separation(x[i], x[j]);
       const double distance_squared = norm_squared(offset);
       const double reach = r[i] + r[j];
       if (distance_squared >= reach * reach) {
@@ -222,7 +235,7 @@ void World<D>::evaluate_wall_contacts() {
         if (slot == max_wall_contacts) {
           slot = 0;
           while (slot < max_wall_contacts && slot_id[slot] >= 0) ++slot;
-          if (slot == max_wall_contacts) return;  // cannot happen: at most 4 walls reach a disc
+          if (slot == max_wall_contacts) return;  // cannot happen: see max_wall_contacts
           slot_id[slot] = contact.wall_id;
         }
         seen[static_cast<std::size_t>(slot)] = true;
@@ -242,13 +255,13 @@ void World<D>::evaluate_wall_contacts() {
         moment += -radius * cross(contact.normal, out.tangential_force);
         dissipated += out.dissipated;
         if (contact.kind != WallKind::plane) {
-          if constexpr (D == 2) torque += cross(contact.point, out.force);
+          torque += axial_moment(contact.point, out.force);
           work += dot(out.force, contact.wall_velocity) * dt;
         }
       });
       for (int slot = 0; slot < max_wall_contacts; ++slot) {
         if (slot_id[slot] < 0 || seen[static_cast<std::size_t>(slot)]) continue;
-        block_ended[ended++] = {wall_contact_type(wall_kind(slot_id[slot])),
+        block_ended[ended++] = {wall_contact_type(walls_.kind_of(slot_id[slot])),
                                 slot_history[slot].dissipated};
         slot_history[slot] = ContactHistory<D>{};
         slot_id[slot] = -1;
@@ -315,6 +328,15 @@ void World<D>::integrate() {
     p.position[i] += dt * p.velocity[i];
     p.angular_velocity[i] += (p.inverse_inertia[i] * dt) * p.torque[i];
   }
+  const double period = neighbours_.period();
+  if (period > 0.0) {
+    // Keep positions in [0, period) along the periodic axis.
+    for (std::size_t i = 0; i < count; ++i) {
+      double& z = p.position[i][D - 1];
+      if (z < 0.0) z += period;
+      if (z >= period) z -= period;
+    }
+  }
 }
 
 template <int D>
@@ -368,5 +390,6 @@ double World<D>::stored_spring_energy() const {
 }
 
 template class World<2>;
+template class World<3>;
 
 }  // namespace millsim

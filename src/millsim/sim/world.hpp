@@ -35,7 +35,8 @@ struct EnergyAccount {
 template <int D>
 class World {
  public:
-  static constexpr int max_wall_contacts = 4;  ///< per particle: shell and up to three lifters
+  /// Per particle: shell and up to three lifters, and in 3D an end plate (and one spare).
+  static constexpr int max_wall_contacts = D == 2 ? 4 : 6;
 
   World(const WorldSettings<D>& settings, const Walls<D>& walls);
 
@@ -75,7 +76,8 @@ class World {
   void integrate();
   void advance_walls();
 
-  WallKind wall_kind(int wall_id) const;
+  /// Period of the mill's axis when it is a periodic slab, else 0.
+  double axial_period() const;
 
   /// A collision that ended in a parallel stage, recorded in the spectrum after it in a fixed
   /// order (blocks in order, then in the order they were found), so any thread count gives the
@@ -131,5 +133,6 @@ class World {
 };
 
 extern template class World<2>;
+extern template class World<3>;
 
 }  // namespace millsim
