@@ -1,5 +1,6 @@
 // millsim: the command-line program. `millsim --help` lists the commands.
 #include <fmt/format.h>
+#include <omp.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -27,6 +28,7 @@ struct JobOptions {
   std::vector<std::string> overrides;
   std::string output_directory;  // empty: from the config
   bool quiet = false;
+  int threads = 0;  // 0: all available cores
 };
 
 MillConfig load(const JobOptions& options) {
@@ -198,6 +200,10 @@ int validate_command(const std::string& directory, const JobOptions& options) {
 void add_job_options(CLI::App& command, JobOptions& options) {
   command.add_option("--set", options.overrides,
                      "override a config key, e.g. --set mill.speed=0.75 (repeatable)");
+  command
+      .add_option("-j,--threads", options.threads,
+                  "threads to use (default: all available cores); results do not depend on it")
+      ->check(CLI::Range(1, 1024));
   command.add_flag("-q,--quiet", options.quiet, "print only the one-line summary");
 }
 
@@ -237,6 +243,7 @@ int main(int argc, char** argv) {
                error.what());
     return 2;
   }
+  if (options.threads > 0) omp_set_num_threads(options.threads);
   try {
     if (run->parsed()) return run_command(options);
     if (info->parsed()) return info_command(options);
