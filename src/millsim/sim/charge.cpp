@@ -51,7 +51,7 @@ MillPlan plan_mill(const MillConfig& config) {
     // A ball must not meet two images of another across the period.
     throw InputError(fmt::format(
         "{}: mill.slab_length: {} m is too short for balls of {} m; allowed: at least three "
-        "largest ball diameters, {} m, and at most mill.length",
+        "largest ball diameters, {:.4g} m, and at most mill.length",
         config.location_of("mill.slab_length"), config.slab_length, plan.largest_ball,
         3.0 * plan.largest_ball));
   }

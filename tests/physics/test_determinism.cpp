@@ -1,0 +1,285 @@
+// Deterministic by construction (STYLE.md rule 5): the same scene stepped on one thread and on
+// two gives bitwise-identical particles, energy accounts and collision spectra. The stages of
+// World::step() go parallel only above 2048 items (particles, neighbour pairs, wall
+// candidates; `parallel_threshold` in sim/world.cpp), so the scenes are big enough for every
+// parallel path to run, and the test checks that they are.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+#include <cstddef>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "millsim/io/config.hpp"
+#include "millsim/measure/spectrum.hpp"
+#include "millsim/sim/charge.hpp"
+#include "millsim/sim/world.hpp"
+
+namespace millsim {
+namespace {
+
+/// The item count above which a stage of World::step() runs in parallel (sim/world.cpp).
+constexpr std::size_t parallel_threshold = 2048;
+
+/// Sets the OpenMP thread count for the life of the object, then puts the old one back.
+class ThreadCount {
+ public:
+  explicit ThreadCount(int threads) : previous_(omp_get_max_threads()) {
+    omp_set_num_threads(threads);
+  }
+  ~ThreadCount() { omp_set_num_threads(previous_); }
+  ThreadCount(const ThreadCount&) = delete;
+  ThreadCount& operator=(const ThreadCount&) = delete;
+
+ private:
+  int previous_;
+};
+
+template <int D>
+struct Outcome {
+  World<D> world;
+  ImpactSpectrum spectrum;
+};
+
+/// The plan's world with its charge set in motion: every particle moving at up to `speed`
+/// (m/s) in a random direction with a random spin, the mill turning at the plan's speed, and
+/// then `steps` steps on one thread. The charge is placed without contacts; this makes
+/// collisions from the first steps instead of after a long fall, so that the stepping compared
+/// below starts from a scene full of contacts and contact history. For a denser scene,
+/// `compress` (≤ 1) first draws the particles within `inner` (m) of the axis in towards it by
+/// that factor; those beyond stay where they are, among the lifters.
+template <int D>
+World<D> moving_scene(const MillPlan& plan, double inner, double compress, double speed,
+                      int steps) {
+  const ThreadCount one_thread(1);
+  World<D> world = build_mill_world<D>(plan);
+  auto& p = world.particles();
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (std::hypot(p.position[i][0], p.position[i][1]) < inner) {
+      for (int a = 0; a < 2; ++a) p.position[i][a] *= compress;
+    }
+    for (int a = 0; a < D; ++a) p.velocity[i][a] = speed * uniform(random) / std::sqrt(D);
+    const double spin_scale = speed / p.radius[i];
+    if constexpr (D == 2) {
+      p.angular_velocity[i] = spin_scale * uniform(random);
+    } else {
+      for (int a = 0; a < 3; ++a) p.angular_velocity[i][a] = spin_scale * uniform(random);
+    }
+  }
+  world.walls().mill->angular_speed = plan.angular_speed;
+  for (int n = 0; n < steps; ++n) world.step();
+  return world;
+}
+
+/// Steps a copy of `scene` `steps` times on `threads` threads, recording the collisions that
+/// end.
+template <int D>
+Outcome<D> step_on(const World<D>& scene, int steps, int threads) {
+  const ThreadCount thread_count(threads);
+  EXPECT_EQ(omp_get_max_threads(), threads);
+  int team = 0;
+#pragma omp parallel
+  {
+#pragma omp single
+    team = omp_get_num_threads();
+  }
+  EXPECT_EQ(team, threads) << "OpenMP did not give the team asked for";
+  Outcome<D> outcome{scene, ImpactSpectrum{}};
+  outcome.world.record_collisions_in(&outcome.spectrum);
+  for (int n = 0; n < steps; ++n) outcome.world.step();
+  outcome.world.record_collisions_in(nullptr);
+  return outcome;
+}
+
+/// Pairs closer than the neighbour list's cut-off, r_i + r_j + skin: roughly the pairs the pair
+/// stage worked on in the last steps (counted by brute force, along a periodic axis by the
+/// nearest image).
+template <int D>
+std::size_t listed_pairs(const World<D>& world) {
+  const auto& p = world.particles();
+  const double skin = world.settings().skin;
+  double period = 0.0;
+  if constexpr (D == 3) {
+    if (world.walls().mill->periodic) period = world.walls().mill->length;
+  }
+  std::size_t pairs = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::size_t j = i + 1; j < p.size(); ++j) {
+      Vec<D> offset = p.position[j] - p.position[i];
+      if (period > 0.0) offset[D - 1] -= period * std::nearbyint(offset[D - 1] / period);
+      const double reach = p.radius[i] + p.radius[j] + skin;
+      if (norm_squared(offset) < reach * reach) ++pairs;
+    }
+  }
+  return pairs;
+}
+
+/// Particles that may touch a wall within a skin: the wall stage's candidates.
+template <int D>
+std::size_t wall_candidates(const World<D>& world) {
+  const auto& p = world.particles();
+  std::size_t candidates = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (world.walls().may_touch(p.position[i], p.radius[i], world.settings().skin)) ++candidates;
+  }
+  return candidates;
+}
+
+/// Everything a step produces, compared with ==: particle by particle, then the energy
+/// accounts, the drive torque, the contacts and the spectrum bin by bin.
+template <int D>
+void expect_identical(const Outcome<D>& one, const Outcome<D>& two) {
+  const auto& a = one.world.particles();
+  const auto& b = two.world.particles();
+  ASSERT_EQ(a.size(), b.size());
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const bool same = a.position[i] == b.position[i] && a.velocity[i] == b.velocity[i] &&
+                      a.angular_velocity[i] == b.angular_velocity[i] && a.force[i] == b.force[i] &&
+                      a.torque[i] == b.torque[i];
+    if (!same && differing++ < 5) {
+      ADD_FAILURE() << "particle " << i << " differs between 1 and 2 threads";
+    }
+  }
+  EXPECT_EQ(differing, 0u) << "particles that differ";
+  const World<D>& wa = one.world;
+  const World<D>& wb = two.world;
+  EXPECT_EQ(wa.energy_account().shell_work, wb.energy_account().shell_work);
+  EXPECT_EQ(wa.energy_account().dissipated, wb.energy_account().dissipated);
+  EXPECT_EQ(wa.last_step_dissipation(), wb.last_step_dissipation());
+  EXPECT_EQ(wa.shell_torque(), wb.shell_torque());
+  EXPECT_EQ(wa.kinetic_energy(), wb.kinetic_energy());
+  EXPECT_EQ(wa.potential_energy(), wb.potential_energy());
+  EXPECT_EQ(wa.stored_spring_energy(), wb.stored_spring_energy());
+  EXPECT_EQ(wa.touching_contacts(), wb.touching_contacts());
+  EXPECT_EQ(wa.neighbour_rebuilds(), wb.neighbour_rebuilds());
+  EXPECT_EQ(wa.walls().mill->angle, wb.walls().mill->angle);
+  for (std::size_t t = 0; t < contact_type_count; ++t) {
+    const auto type = static_cast<ContactType>(t);
+    for (std::size_t bin = 0; bin < one.spectrum.bin_count(); ++bin) {
+      EXPECT_EQ(one.spectrum.count(type, bin), two.spectrum.count(type, bin))
+          << contact_type_name(type) << " bin " << bin;
+      EXPECT_EQ(one.spectrum.energy(type, bin), two.spectrum.energy(type, bin))
+          << contact_type_name(type) << " bin " << bin;
+    }
+  }
+}
+
+TEST(Determinism, SagMill2DIsTheSameOnOneAndTwoThreads) {
+  // The 2D SAG benchmark scene (bench/sag-12m-2d.toml): a 12 m mill with forty lifters and
+  // about 7 000 discs of 25–150 mm, Δt = 4.5e-5 s, the shell turning at 5 rpm. The charge is
+  // placed over the whole mill (30 % filling, so a fifth of its area). The discs within 5.5 m
+  // of the axis are drawn in by 0.7 (those beyond, among the 0.2 m lifters from 5.8 m out,
+  // stay), all are set moving at up to 3 m/s, and after 200 steps there are thousands of close
+  // pairs and hundreds of contacts, some with the shell and lifters. From there, 80 steps on
+  // one thread and on two.
+  const MillPlan plan = plan_mill(load_mill_config(
+      std::string(MILLSIM_SOURCE_DIR) + "/bench/sag-12m-2d.toml", {"output.snapshot_interval=0"}));
+  const World<2> scene = moving_scene<2>(plan, 5.5, 0.7, 3.0, 200);
+  const Outcome<2> one = step_on(scene, 80, 1);
+  const Outcome<2> two = step_on(scene, 80, 2);
+  expect_identical(one, two);
+
+  // The parallel paths ran: particles and listed pairs above the threshold (the wall stage's
+  // candidates, the discs near the shell, stay below it here; the 3D scene covers it), and the
+  // neighbour list was rebuilt, carrying contact history, during the compared steps.
+  const World<2>& world = one.world;
+  EXPECT_GT(world.particles().size(), parallel_threshold);
+  EXPECT_GT(listed_pairs(world), 2 * parallel_threshold);
+  EXPECT_GT(world.neighbour_rebuilds(), scene.neighbour_rebuilds());
+  // Something happened worth comparing: contacts with each other and with the walls.
+  EXPECT_GT(world.touching_contacts(), 300u);
+  EXPECT_GT(one.spectrum.total_count(ContactType::ball_ball), 100);
+  EXPECT_GT(world.energy_account().dissipated, scene.energy_account().dissipated);
+  EXPECT_NE(world.energy_account().shell_work, scene.energy_account().shell_work);
+}
+
+/// A short, wide 3D mill full of 1 cm balls: 0.8 m across and only 3 cm long between its end
+/// plates (or a periodic slab of 3 cm), sixteen 2 × 2 cm lifters, J = 0.3, 80 % of critical
+/// speed. About 5 000 balls; with end plates two thirds of them lie within a skin (a ball
+/// radius) of one, so the wall stage has thousands of candidates.
+std::string short_wide_mill(bool periodic) {
+  return fmt::format(R"(
+[simulation]
+dimension = 3
+time_step = "auto"
+settle_time = 0.1
+revolutions = 1
+measure_revolutions = 1
+seed = 3
+
+[mill]
+diameter = 0.8
+length = {}
+speed = 0.8
+{}
+
+[mill.lifters]
+count = 16
+height = 0.02
+width = 0.02
+
+[charge]
+filling = 0.30
+porosity = 0.4
+density = 7800
+ball_diameter = 0.01
+
+[materials.ball_ball]
+normal_stiffness = 4.0e5
+tangential_stiffness = 3.0e5
+restitution = 0.6
+friction = 0.6
+
+[materials.ball_wall]
+normal_stiffness = 4.0e5
+tangential_stiffness = 3.0e5
+restitution = 0.5
+friction = 0.6
+
+[output]
+directory = "runs/tests/determinism"
+snapshot_interval = 0
+)",
+                     periodic ? "0.3" : "0.03",
+                     periodic ? "periodic = true\nslab_length = 0.03" : "");
+}
+
+void expect_3d_scene_deterministic(bool periodic) {
+  // Set moving at up to 4 m/s, 200 steps on one thread (2.3 ms), then 100 more on one and on
+  // two threads.
+  const MillPlan plan =
+      plan_mill(parse_mill_config(short_wide_mill(periodic), "short-wide-mill.toml"));
+  const World<3> scene = moving_scene<3>(plan, 0.0, 1.0, 4.0, 200);
+  const Outcome<3> one = step_on(scene, 100, 1);
+  const Outcome<3> two = step_on(scene, 100, 2);
+  expect_identical(one, two);
+
+  const World<3>& world = one.world;
+  EXPECT_GT(world.particles().size(), parallel_threshold);
+  EXPECT_GT(listed_pairs(world), 2 * parallel_threshold);
+  EXPECT_GT(world.neighbour_rebuilds(), scene.neighbour_rebuilds());
+  EXPECT_GT(world.touching_contacts(), 100u);
+  EXPECT_GT(one.spectrum.total_count(ContactType::ball_ball), 100);
+  EXPECT_GT(world.energy_account().dissipated, scene.energy_account().dissipated);
+  if (!periodic) {
+    EXPECT_GT(wall_candidates(world), parallel_threshold);
+    EXPECT_GT(one.spectrum.total_count(ContactType::ball_end_plate), 100);
+  }
+}
+
+TEST(Determinism, ShortWideMill3DIsTheSameOnOneAndTwoThreads) {
+  expect_3d_scene_deterministic(false);
+}
+
+TEST(Determinism, PeriodicSlab3DIsTheSameOnOneAndTwoThreads) {
+  expect_3d_scene_deterministic(true);
+}
+
+}  // namespace
+}  // namespace millsim
