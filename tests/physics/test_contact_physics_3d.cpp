@@ -21,25 +21,16 @@
 #include "millsim/measure/spectrum.hpp"
 #include "millsim/particles/material.hpp"
 #include "millsim/sim/world.hpp"
+#include "physics/impact_answers.hpp"
 
 namespace millsim {
 namespace {
 
-constexpr double restitutions[] = {0.2, 0.5, 0.8, 0.95};
+using namespace impact_answers;
 
 // A stiff spring: the largest overlap v0/ω0 is about 1 % of a radius.
 constexpr double sphere_radius = 0.05;  // m
 constexpr double approach_speed = 1.0;  // m/s
-
-ContactMaterial material_with(double restitution) {
-  return ContactMaterial{1.0e6, 2.0e6 / 3.0, restitution, 0.5};
-}
-
-// Δt = t_c/200 resolves the force history well below the 1 % and 2 % tolerances, and the touch
-// falls half-way between two samples of the positions (the midpoint rule for the dashpot's jump
-// from 0 to c_n v0 at the touch); test_contact_physics.cpp explains both choices.
-constexpr double steps_per_contact = 200.0;
-constexpr double free_flight_steps = 40.5;
 
 // An orthonormal triad with components in sevenths, none along an axis: the normal of the
 // oblique planes, a tangent in them, and normal × tangent. The pair axis is another oblique one.
@@ -49,36 +40,9 @@ constexpr Vec3 plane_binormal{{-2.0 / 7.0, 3.0 / 7.0, -6.0 / 7.0}};  // plane_no
 constexpr Vec3 plane_point{{0.1, -0.2, 0.3}};
 constexpr Vec3 pair_axis{{2.0 / 7.0, 3.0 / 7.0, 6.0 / 7.0}};
 
-void record(const std::string& key, double value) {
-  ::testing::Test::RecordProperty(key, fmt::format("{:.6g}", value));
-}
-
 /// The part of `a` perpendicular to the unit vector `n`.
 Vec3 perpendicular_part(const Vec3& a, const Vec3& n) {
   return a - dot(a, n) * n;
-}
-
-/// The normal impact of the law without tension, solved exactly (derived in full in
-/// test_contact_physics.cpp): with ω0² = k_n/m*, ζ = sin α, ω_d = ω0 sqrt(1 − ζ²), the contact
-/// force is ∝ sin(ω_d t + 2α) and first vanishes at t* = (π − 2α)/ω_d, where the separation
-/// speed is v0 e^{−ζω0 t*}: e_eff = exp(−tan α (π − 2α)). With tension the overlap runs on to
-/// ω_d t = π and the restitution is e = exp(−π tan α), Corkum's relation.
-struct ImpactAnswer {
-  double restitution = 0.0;
-  double duration = 0.0;  ///< s, of the force for no tension, of the overlap with tension
-};
-
-ImpactAnswer no_tension_impact(const ContactMaterial& material, double effective_mass) {
-  const double zeta = damping_ratio(material.restitution);
-  const double alpha = std::asin(zeta);
-  const double natural = std::sqrt(material.normal_stiffness / effective_mass);  // ω0
-  const double damped = natural * std::sqrt(1.0 - zeta * zeta);                  // ω_d
-  const double duration = (pi - 2.0 * alpha) / damped;
-  return {std::exp(-zeta * natural * duration), duration};
-}
-
-ImpactAnswer corkum_impact(const ContactMaterial& material, double effective_mass) {
-  return {material.restitution, contact_duration(material, effective_mass)};
 }
 
 ImpactAnswer impact_answer(const ContactMaterial& material, double effective_mass,
