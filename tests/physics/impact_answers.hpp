@@ -6,11 +6,15 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <string>
+#include <vector>
 
 #include "millsim/core/constants.hpp"
 #include "millsim/particles/material.hpp"
+#include "millsim/sim/world.hpp"
 
 namespace millsim::impact_answers {
 
@@ -64,6 +68,32 @@ inline ImpactAnswer no_tension_impact(const ContactMaterial& material, double ef
 
 inline ImpactAnswer corkum_impact(const ContactMaterial& material, double effective_mass) {
   return {material.restitution, contact_duration(material, effective_mass)};
+}
+
+/// Steps `world` until particle 0, bouncing on a floor whose normal is coordinate `axis`, has
+/// made `count` whole flights after its first bounce (or `time_limit` s have passed), and
+/// returns the highest centre height of each of those flights.
+template <int D>
+std::vector<double> bounce_apexes(World<D>& world, int axis, double radius, std::size_t count,
+                                  double time_limit) {
+  std::vector<double> apexes;
+  bool airborne = true;
+  bool bounced = false;
+  double highest = 0.0;
+  while (apexes.size() < count && world.time() < time_limit) {
+    world.step();
+    const double height = world.particles().position[0][axis];
+    if (airborne && height < radius) {  // landing: the flight since the bounce is over
+      if (bounced) apexes.push_back(highest);
+      airborne = false;
+    } else if (!airborne && height >= radius) {  // take-off
+      airborne = true;
+      bounced = true;
+      highest = height;
+    }
+    if (airborne) highest = std::max(highest, height);
+  }
+  return apexes;
 }
 
 }  // namespace millsim::impact_answers

@@ -224,23 +224,7 @@ TEST(BounceOnFloor, ApexHeightsFallAsRestitutionSquared) {
   World<2> world(settings, walls);
   world.particles().add(Vec2{{0.0, drop_height}}, disc_radius, mass);
 
-  std::vector<double> apexes;
-  bool airborne = true;
-  bool bounced = false;
-  double highest = 0.0;
-  while (apexes.size() < 3 && world.time() < 3.0) {
-    world.step();
-    const double height = world.particles().position[0][1];
-    if (airborne && height < disc_radius) {  // landing: the flight since the bounce is over
-      if (bounced) apexes.push_back(highest);
-      airborne = false;
-    } else if (!airborne && height >= disc_radius) {  // take-off
-      airborne = true;
-      bounced = true;
-      highest = height;
-    }
-    if (airborne) highest = std::max(highest, height);
-  }
+  const std::vector<double> apexes = bounce_apexes(world, 1, disc_radius, 3, 3.0);
   ASSERT_EQ(apexes.size(), 3U);
   for (std::size_t k = 1; k <= apexes.size(); ++k) {
     const double expected =

@@ -254,23 +254,7 @@ TEST(BounceOnFloor3D, SphereApexHeightsFallAsEffectiveRestitutionSquared) {
   world.particles().add(Vec3{{0.2, -0.1, drop_height}}, sphere_radius, mass);
   const double effective_restitution = no_tension_impact(material, mass).restitution;
 
-  std::vector<double> apexes;
-  bool airborne = true;
-  bool bounced = false;
-  double highest = 0.0;
-  while (apexes.size() < 3 && world.time() < 3.0) {
-    world.step();
-    const double height = world.particles().position[0][2];
-    if (airborne && height < sphere_radius) {  // landing: the flight since the bounce is over
-      if (bounced) apexes.push_back(highest);
-      airborne = false;
-    } else if (!airborne && height >= sphere_radius) {  // take-off
-      airborne = true;
-      bounced = true;
-      highest = height;
-    }
-    if (airborne) highest = std::max(highest, height);
-  }
+  const std::vector<double> apexes = bounce_apexes(world, 2, sphere_radius, 3, 3.0);
   ASSERT_EQ(apexes.size(), 3U);
   record("effective_restitution", effective_restitution);
   for (std::size_t k = 1; k <= apexes.size(); ++k) {
