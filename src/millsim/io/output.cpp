@@ -4,9 +4,12 @@
 #include <fmt/os.h>
 #include <toml++/toml.h>
 
+#include <cstdint>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 
+#include "millsim/measure/empirical_power.hpp"
 #include "millsim/sim/mill_run.hpp"
 
 namespace millsim {
@@ -66,6 +69,106 @@ std::string spectrum_table(const MillResult& result) {
   return text;
 }
 
+/// One number of summary.json; `whole` numbers are written as JSON integers.
+struct SummaryNumber {
+  std::string name;  ///< dotted for nested objects
+  double value = 0.0;
+  bool whole = false;
+};
+
+/// summary.json's "empirical" object: the three models' powers, the inputs they were given and
+/// the intermediate quantities of each (docs/empirical_power.md).
+void append_empirical_numbers(std::vector<SummaryNumber>& numbers, const EmpiricalPower& p) {
+  const EmpiricalPowerInputs& in = p.inputs;
+  const MorrellPower& m = p.morrell;
+  const std::vector<SummaryNumber> empirical{
+      {"empirical.bond_kw", p.bond.power_kw},
+      {"empirical.hogg_fuerstenau_kw", p.hogg_fuerstenau.power_kw},
+      {"empirical.morrell_net_kw", m.net_kw},
+      {"empirical.inputs.diameter_m", in.diameter},
+      {"empirical.inputs.length_m", in.length},
+      {"empirical.inputs.filling", in.filling},
+      {"empirical.inputs.speed_rpm", in.speed_rpm},
+      {"empirical.inputs.shell_critical_speed_rpm", in.shell_critical_speed_rpm},
+      {"empirical.inputs.speed_fraction_of_shell_critical", in.speed_fraction},
+      {"empirical.inputs.ball_density_kg_m3", in.ball_density},
+      {"empirical.inputs.porosity", in.porosity},
+      {"empirical.inputs.bed_density_kg_m3", in.bed_density},
+      {"empirical.inputs.ball_charge_mass_kg", in.ball_charge_mass},
+      {"empirical.inputs.top_ball_diameter_m", in.top_ball_diameter},
+      {"empirical.inputs.repose_angle_rad", in.repose_angle},
+      {"empirical.bond.kw_per_ball_tonne", p.bond.kw_per_ball_tonne},
+      {"empirical.bond.ball_size_factor_kw_per_tonne", p.bond.ball_size_factor},
+      {"empirical.hogg_fuerstenau.segment_half_angle_rad", p.hogg_fuerstenau.half_angle},
+      {"empirical.hogg_fuerstenau.centre_of_mass_radius_m",
+       p.hogg_fuerstenau.centre_of_mass_radius},
+      {"empirical.morrell.charge_motion_kw", m.charge_motion_kw},
+      {"empirical.morrell.calibration_k", morrell_calibration},
+      {"empirical.morrell.centrifuging_speed_fraction", m.centrifuging_speed_fraction},
+      {"empirical.morrell.toe_angle_rad", m.toe_angle},
+      {"empirical.morrell.shoulder_angle_rad", m.shoulder_angle},
+      {"empirical.morrell.mean_radius_m", m.mean_radius},
+      {"empirical.morrell.active_fraction", m.active_fraction},
+      {"empirical.morrell.inner_radius_m", m.inner_radius},
+      {"empirical.morrell.z", m.z},
+  };
+  numbers.insert(numbers.end(), empirical.begin(), empirical.end());
+}
+
+std::vector<SummaryNumber> summary_numbers(const MillResult& r) {
+  const MillPlan& plan = r.plan;
+  const MillConfig& c = plan.config;
+  const auto count = [](auto n) { return static_cast<double>(n); };
+  std::vector<SummaryNumber> numbers{
+      {"power_kw", r.power_kw},
+      {"power_dissipation_kw", r.power_dissipation_kw},
+      {"power_std_kw", r.power_std_kw},
+      {"torque_nm", r.torque_nm},
+      {"energy_balance_error", r.energy_balance_error},
+      {"critical_speed_rpm", plan.critical_speed_rpm},
+      {"speed_rpm", plan.speed_rpm},
+      {"speed_fraction_of_critical", plan.speed_fraction},
+      {"particle_count", count(plan.particle_count), true},
+      {"time_step_s", plan.time_step},
+      {"steps", count(r.steps), true},
+      {"simulated_seconds", r.simulated_seconds},
+      {"wall_seconds", r.wall_seconds},
+      {"particle_steps_per_second", r.particle_steps_per_second},
+      {"measured_revolutions", count(c.measure_revolutions), true},
+      {"slice_charge_mass_kg", plan.slice_mass},
+      {"mill_charge_mass_kg", plan.mill_charge_mass},
+      {"power_scale", plan.power_scale},
+      {"charge_orbital_speed_ratio", r.orbital_speed_ratio},
+      {"dimension", count(c.dimension), true},
+  };
+  append_empirical_numbers(numbers, empirical_power(plan));
+  if (c.reference) {
+    numbers.push_back({"reference.measured_power_kw", c.reference->measured_kw});
+    numbers.push_back({"reference.tolerance", c.reference->tolerance});
+    if (c.reference->paper_kw) {
+      numbers.push_back({"reference.paper_power_kw", *c.reference->paper_kw});
+    }
+  }
+  return numbers;
+}
+
+/// Puts `number` into `table`, creating the nested objects its dotted name asks for.
+void insert_number(toml::table& table, const SummaryNumber& number) {
+  toml::table* parent = &table;
+  std::string_view name = number.name;
+  for (auto dot = name.find('.'); dot != std::string_view::npos; dot = name.find('.')) {
+    const std::string_view key = name.substr(0, dot);
+    if (!parent->contains(key)) parent->insert(key, toml::table{});
+    parent = parent->get_as<toml::table>(key);
+    name.remove_prefix(dot + 1);
+  }
+  if (number.whole) {
+    parent->insert_or_assign(name, static_cast<std::int64_t>(number.value));
+  } else {
+    parent->insert_or_assign(name, number.value);
+  }
+}
+
 }  // namespace
 
 void write_snapshot(const std::filesystem::path& directory, int index, const World<3>& world) {
@@ -101,10 +204,15 @@ void write_snapshot(const std::filesystem::path& directory, int index, const Wor
   }
 }
 
+std::vector<std::pair<std::string, double>> summary_scalars(const MillResult& result) {
+  std::vector<std::pair<std::string, double>> scalars;
+  for (const SummaryNumber& n : summary_numbers(result)) scalars.emplace_back(n.name, n.value);
+  return scalars;
+}
+
 std::string summary_json(const MillResult& r) {
   const MillPlan& plan = r.plan;
   const MillConfig& c = plan.config;
-  toml::table sizes_table;
   toml::array discs;
   for (const DiscClass& d : plan.discs) {
     discs.push_back(
@@ -112,47 +220,25 @@ std::string summary_json(const MillResult& r) {
   }
   toml::table summary{
       {"config", c.source},
-      {"power_kw", r.power_kw},
-      {"power_dissipation_kw", r.power_dissipation_kw},
-      {"power_std_kw", r.power_std_kw},
-      {"torque_nm", r.torque_nm},
-      {"energy_balance_error", r.energy_balance_error},
-      {"critical_speed_rpm", plan.critical_speed_rpm},
-      {"speed_rpm", plan.speed_rpm},
-      {"speed_fraction_of_critical", plan.speed_fraction},
-      {"particle_count", plan.particle_count},
-      {"time_step_s", plan.time_step},
-      {"steps", r.steps},
-      {"simulated_seconds", r.simulated_seconds},
-      {"wall_seconds", r.wall_seconds},
-      {"particle_steps_per_second", r.particle_steps_per_second},
-      {"measured_revolutions", c.measure_revolutions},
-      {"slice_charge_mass_kg", plan.slice_mass},
-      {"mill_charge_mass_kg", plan.mill_charge_mass},
-      {"power_scale", plan.power_scale},
       {"charge_centre_of_mass_m", toml::array{r.charge_centre[0], r.charge_centre[1]}},
-      {"charge_orbital_speed_ratio", r.orbital_speed_ratio},
       {c.dimension == 2 ? "discs" : "balls", discs},
-      {"dimension", c.dimension},
   };
-  if (c.reference) {
-    toml::table reference{{"case", c.reference->case_name},
-                          {"measured_power_kw", c.reference->measured_kw},
-                          {"tolerance", c.reference->tolerance}};
-    if (c.reference->paper_kw) reference.insert("paper_power_kw", *c.reference->paper_kw);
-    summary.insert("reference", reference);
-  }
+  if (c.reference) summary.insert("reference", toml::table{{"case", c.reference->case_name}});
+  for (const SummaryNumber& n : summary_numbers(r)) insert_number(summary, n);
   std::ostringstream text;
   text << toml::json_formatter{summary} << "\n";
   return text.str();
 }
 
 std::string summary_line(const MillResult& r) {
+  const EmpiricalPower empirical = empirical_power(r.plan);
   return fmt::format(
       "power {:.4g} kW (dissipation {:.4g} kW, ±{:.2g} kW between revolutions) at {:.3g} rpm "
-      "({:.0f}% of critical); {} {}, {} steps in {:.1f} s ({:.3g} particle-steps/s)",
+      "({:.0f}% of critical); empirical: Bond {:.4g} kW, Hogg-Fuerstenau {:.4g} kW, Morrell "
+      "net {:.4g} kW; {} {}, {} steps in {:.1f} s ({:.3g} particle-steps/s)",
       r.power_kw, r.power_dissipation_kw, r.power_std_kw, r.plan.speed_rpm,
-      100.0 * r.plan.speed_fraction, r.plan.particle_count,
+      100.0 * r.plan.speed_fraction, empirical.bond.power_kw, empirical.hogg_fuerstenau.power_kw,
+      empirical.morrell.net_kw, r.plan.particle_count,
       r.plan.config.dimension == 2 ? "discs" : "balls", r.steps, r.wall_seconds,
       r.particle_steps_per_second);
 }

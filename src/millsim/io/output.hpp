@@ -3,6 +3,8 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "millsim/sim/world.hpp"
 
@@ -22,7 +24,14 @@ void write_results(const std::filesystem::path& directory, const MillResult& res
 /// The summary as JSON text (what summary.json holds).
 std::string summary_json(const MillResult& result);
 
-/// The one-line summary printed at the end of a run.
+/// Every number of summary.json as (name, value), in a fixed order; a number inside a nested
+/// object is named with a dot ("reference.measured_power_kw"). Arrays (`discs`/`balls`,
+/// `charge_centre_of_mass_m`) are not in the list. summary.json's numbers are written from
+/// this list, so the two always agree.
+std::vector<std::pair<std::string, double>> summary_scalars(const MillResult& result);
+
+/// The one-line summary printed at the end of a run: the DEM power, with the empirical models'
+/// (measure/empirical_power.hpp) beside it.
 std::string summary_line(const MillResult& result);
 
 }  // namespace millsim

@@ -1,0 +1,321 @@
+// The empirical mill-power models (measure/empirical_power.hpp): each formula against a value
+// worked by hand, the arithmetic in the comment above the check and the expected value computed
+// step by step from literal numbers; then scaling and limiting cases, the inputs millsim takes
+// from a mill plan, and summary.json's "empirical" object.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "millsim/builtin_example.hpp"
+#include "millsim/core/constants.hpp"
+#include "millsim/io/config.hpp"
+#include "millsim/io/output.hpp"
+#include "millsim/measure/empirical_power.hpp"
+#include "millsim/sim/charge.hpp"
+#include "millsim/sim/mill_run.hpp"
+
+namespace millsim {
+namespace {
+
+// A formula re-evaluated from literal numbers agrees to rounding.
+constexpr double formula_tolerance = 1e-9;
+
+#define EXPECT_FORMULA(actual, expected) \
+  EXPECT_NEAR((actual), (expected), std::abs(expected) * formula_tolerance)
+
+/// A round-number mill: D = 2 m, L = 1 m, J = 0.4, 75 % of the shell's critical speed, steel
+/// bed of 7800 kg/m³ with porosity 0.4 (ρ_b = 4680 kg/m³), 5 cm top ball.
+EmpiricalPowerInputs round_mill() {
+  EmpiricalPowerInputs in;
+  in.diameter = 2.0;
+  in.length = 1.0;
+  in.filling = 0.4;
+  // N_c = (60/2π) sqrt(2 × 9.81 / 2) = 9.5492966 × 3.1320919 = 29.909275 rpm.
+  in.shell_critical_speed_rpm = 60.0 / (2.0 * pi) * std::sqrt(2.0 * 9.81 / 2.0);
+  in.speed_fraction = 0.75;
+  in.speed_rpm = 0.75 * in.shell_critical_speed_rpm;  // 22.431956 rpm
+  in.ball_density = 7800.0;
+  in.porosity = 0.4;
+  in.bed_density = 4680.0;
+  // M = ρ_b J π D²/4 L = 4680 × 0.4 × π × 1 × 1 = 5881.0614 kg.
+  in.ball_charge_mass = 4680.0 * 0.4 * pi;
+  in.top_ball_diameter = 0.05;
+  return in;
+}
+
+/// Case 2D-g of MODEL.md §8 as the formulas see it, with round inputs given directly:
+/// D = 4.11 m, L = 5.49 m, J = 0.34, φ = 0.77, 7.6 cm top ball, ρ_b = 4680 kg/m³.
+EmpiricalPowerInputs case_2d_g() {
+  EmpiricalPowerInputs in;
+  in.diameter = 4.11;
+  in.length = 5.49;
+  in.filling = 0.34;
+  in.speed_fraction = 0.77;
+  in.speed_rpm = 16.2;
+  in.ball_density = 7800.0;
+  in.porosity = 0.4;
+  in.bed_density = 4680.0;
+  in.ball_charge_mass = 100000.0;  // 100 t, round for Bond's check
+  in.top_ball_diameter = 0.076;
+  return in;
+}
+
+TEST(EmpiricalPower, BondRoundNumberMill) {
+  EmpiricalPowerInputs in;
+  in.diameter = 1.0;
+  in.filling = 0.4;
+  in.speed_fraction = 0.8;
+  in.top_ball_diameter = 0.05;
+  in.ball_charge_mass = 1000.0;
+  // D^0.3 = 1; 3.2 − 3 × 0.4 = 2; 2^(9 − 8) = 2, so 0.8 × (1 − 0.1/2) = 0.8 × 0.95 = 0.76;
+  // D = 1 m <= 3.3 m: S_s = 0. kWb = 4.879 × 1 × 2 × 0.76 = 7.41608 kW/t; 1 t: 7.41608 kW.
+  const BondPower bond = bond_power(in);
+  EXPECT_EQ(bond.ball_size_factor, 0.0);
+  EXPECT_FORMULA(bond.kw_per_ball_tonne, 4.879 * 1.0 * 2.0 * 0.76);
+  EXPECT_FORMULA(bond.power_kw, 7.41608);
+}
+
+TEST(EmpiricalPower, BondCase2Dg) {
+  const EmpiricalPowerInputs in = case_2d_g();
+  // D^0.3 = 4.11^0.3 = 1.5281027; 3.2 − 3 × 0.34 = 2.18;
+  // 2^(9 − 7.7) = 2^1.3 = 2.4622888, so 0.77 × (1 − 0.1/2.4622888) = 0.73872828;
+  // D > 3.3 m: S_s = 1.102 × (76 − 12.5 × 4.11)/50.8 = 1.102 × 24.625/50.8 = 0.53418799 kW/t.
+  // kWb = 4.879 × 1.5281027 × 2.18 × 0.73872828 + 0.53418799 = 12.540914 kW/t; × 100 t.
+  const double d_power = std::pow(4.11, 0.3);
+  const double speed_term = 0.77 * (1.0 - 0.1 / std::pow(2.0, 1.3));
+  const double size_factor = 1.102 * (76.0 - 12.5 * 4.11) / 50.8;
+  const double kwb = 4.879 * d_power * 2.18 * speed_term + size_factor;
+  const BondPower bond = bond_power(in);
+  EXPECT_FORMULA(bond.ball_size_factor, size_factor);
+  EXPECT_FORMULA(bond.ball_size_factor, 0.53418799212598);
+  EXPECT_FORMULA(bond.kw_per_ball_tonne, kwb);
+  EXPECT_NEAR(bond.kw_per_ball_tonne, 12.540914, 1e-6);
+  EXPECT_FORMULA(bond.power_kw, kwb * 100.0);
+}
+
+TEST(EmpiricalPower, BondBallSizeFactorOnlyAboveThreePointThreeMetres) {
+  // B = 76 mm: D = 3.3 m is not above the limit; D = 3.31 m gives
+  // 1.102 × (76 − 41.375)/50.8 = 0.75111220 kW/t; a 2 m mill none.
+  EXPECT_EQ(bond_ball_size_factor(3.3, 0.076), 0.0);
+  EXPECT_EQ(bond_ball_size_factor(2.0, 0.076), 0.0);
+  EXPECT_FORMULA(bond_ball_size_factor(3.31, 0.076), 1.102 * (76.0 - 12.5 * 3.31) / 50.8);
+  // The factor is what kWb gains over the bare formula.
+  const double bare = 4.879 * std::pow(3.31, 0.3) * (3.2 - 3.0 * 0.34) * 0.77 *
+                      (1.0 - 0.1 / std::pow(2.0, 9.0 - 7.7));
+  EXPECT_FORMULA(bond_kw_per_ball_tonne(3.31, 0.34, 0.77, 0.076),
+                 bare + 1.102 * (76.0 - 41.375) / 50.8);
+  // A small ball in a big mill lowers the power: B = 40 mm, D = 4 m: 1.102 × (40 − 50)/50.8 < 0.
+  EXPECT_LT(bond_ball_size_factor(4.0, 0.040), 0.0);
+}
+
+TEST(EmpiricalPower, SegmentHalfAngle) {
+  // J = (θ − sin θ cos θ)/π: θ = π/2 for a half-full mill, 0 empty, π full.
+  EXPECT_NEAR(segment_half_angle(0.5), pi / 2.0, 1e-14);
+  EXPECT_EQ(segment_half_angle(0.0), 0.0);
+  EXPECT_NEAR(segment_half_angle(1.0), pi, 1e-14);
+  // J = 0.34: θ = 1.3138911 rad, and θ − sin θ cos θ = 1.0681415 = 0.34 π.
+  const double theta = segment_half_angle(0.34);
+  EXPECT_NEAR(theta, 1.3138911138, 1e-9);
+  EXPECT_NEAR(theta - std::sin(theta) * std::cos(theta), 0.34 * pi, 1e-14);
+}
+
+TEST(EmpiricalPower, HoggFuerstenauHalfFilledMill) {
+  EmpiricalPowerInputs in = round_mill();
+  in.filling = 0.5;
+  in.speed_rpm = 30.0;
+  in.repose_angle = pi / 6.0;
+  in.ball_charge_mass = 4680.0 * 0.5 * pi;
+  // J = 0.5: θ = π/2, sin³θ = 1; r_c = 2 R/(3 × π/2) = 4/(3π) = 0.42441318 m.
+  // P = (4π/3) N g ρ_b L R³ sin³θ sin α = 4.1887902 × 0.5 × 9.81 × 4680 × 1 × 1 × 1 × 0.5
+  //   = 48077.677 W = 48.077677 kW.
+  const HoggFuerstenauPower hf = hogg_fuerstenau_power(in);
+  EXPECT_NEAR(hf.half_angle, pi / 2.0, 1e-14);
+  EXPECT_FORMULA(hf.centre_of_mass_radius, 4.0 / (3.0 * pi));
+  EXPECT_FORMULA(hf.power_kw, 4.0 * pi / 3.0 * 0.5 * 9.81 * 4680.0 * 0.5 / 1000.0);
+  EXPECT_NEAR(hf.power_kw, 48.077677, 1e-6);
+  // The same as 2π N M g r_c sin α with M = 4680 × 0.5 × π = 7351.3268 kg.
+  EXPECT_FORMULA(hf.power_kw,
+                 2.0 * pi * 0.5 * (4680.0 * 0.5 * pi) * 9.81 * (4.0 / (3.0 * pi)) * 0.5 / 1000.0);
+}
+
+TEST(EmpiricalPower, HoggFuerstenauCase2Dg) {
+  const EmpiricalPowerInputs in = case_2d_g();
+  // θ = 1.3138911 rad (SegmentHalfAngle), sin θ = 0.96718096, sin³θ = 0.90473879;
+  // R = 2.055 m: r_c = 2 × 2.055 × 0.90473879 / (3 × 1.0681415) = 1.1604194 m;
+  // M = 4680 × 0.34 × π × 2.055² × 5.49 = 115896.59 kg; N = 16.2/60 = 0.27 rev/s; sin 35° =
+  // 0.57357644. P = 2π × 0.27 × 115896.59 × 9.81 × 1.1604194 × 0.57357644 = 1283.7769 kW.
+  const double theta = 1.3138911138074814;
+  const double r_c = 2.0 * 2.055 * std::pow(std::sin(theta), 3) /
+                     (3.0 * (theta - std::sin(theta) * std::cos(theta)));
+  const double mass = 4680.0 * 0.34 * pi * 2.055 * 2.055 * 5.49;
+  const double expected = 2.0 * pi * 0.27 * mass * 9.81 * r_c * std::sin(35.0 * pi / 180.0) / 1000;
+  const HoggFuerstenauPower hf = hogg_fuerstenau_power(in);
+  EXPECT_NEAR(hf.half_angle, theta, 1e-12);
+  EXPECT_NEAR(hf.centre_of_mass_radius, r_c, 1e-11);
+  EXPECT_NEAR(hf.power_kw, expected, expected * 1e-11);
+  EXPECT_NEAR(hf.power_kw, 1283.7769, 1e-4);
+}
+
+TEST(EmpiricalPower, MorrellRoundNumberMill) {
+  const EmpiricalPowerInputs in = round_mill();
+  // φ = 0.75, J = 0.4: 0.35 × (3.364 − 0.4) = 1.0374 > φ, so φ_c = 1.0374.
+  const double phi_c = 0.35 * (3.364 - 0.4);
+  // θ_T = 2.5307 × (1.2796 − 0.4) × (1 − e^(−19.42 × 0.2874)) + π/2
+  //     = 2.22600 × (1 − 0.0037676342) + 1.5707963 = 3.7884133 rad.
+  const double toe = 2.5307 * 0.8796 * (1.0 - std::exp(-19.42 * (phi_c - 0.75))) + pi / 2.0;
+  // θ_S = π/2 − (θ_T − π/2) × [(0.3386 + 0.1041 × 0.75) + (1.54 − 2.5673 × 0.75) × 0.4]
+  //     = 1.5707963 − 2.2176170 × 0.262485 = 0.98870514 rad.
+  const double shoulder = pi / 2.0 - (toe - pi / 2.0) * 0.262485;
+  // Active arc 2π + θ_S − θ_T = 3.4834772 rad; r_m = 1 m;
+  // r̄ = 0.5 × (1 + sqrt(1 − 2π × 0.4/3.4834772)) = 0.76387293 m.
+  const double arc = 2.0 * pi + shoulder - toe;
+  const double mean_radius = 0.5 * (1.0 + std::sqrt(1.0 - 2.0 * pi * 0.4 / arc));
+  // N_m = 22.431956/60 = 0.37386594 rev/s, N = N_m/2; t_c = arc/(2π N) = 2.9658364 s;
+  // sin θ_S − sin θ_T = 0.83531480 + 0.60265230 = 1.4379671;
+  // t_f = sqrt(2 × 0.76387293 × 1.4379671/9.81) = 0.47322266 s; β = t_c/(t_f + t_c) = 0.86239764.
+  const double n_m = 0.75 * 29.909274989176860 / 60.0;
+  const double t_c = arc / (2.0 * pi * 0.5 * n_m);
+  const double drop = std::sin(shoulder) - std::sin(toe);
+  const double t_f = std::sqrt(2.0 * mean_radius * drop / 9.81);
+  const double beta = t_c / (t_f + t_c);
+  // r_i = sqrt(1 − 2π × 0.86239764 × 0.4/3.4834772) = 0.61464920 m; z = 0.6^0.4532 = 0.79333780.
+  const double r_i = std::sqrt(1.0 - 2.0 * pi * beta * 0.4 / arc);
+  const double z = std::pow(0.6, 0.4532);
+  // r_m − z r_i = 0.51237556; [2 − 3 z r_i + r_i³ (3z − 2)] = 0.62536980;
+  // potential = π × 9.81 × 1 × N_m × 1/(3 × 0.51237556) × 0.62536980 × 4680 × 1.4379671
+  //           = 31546.910 W;
+  // kinetic = 1 × 4680 × (N_m π/0.51237556)³ × [0.51237556⁴ − r_i⁴ (z − 1)⁴]
+  //         = 4680 × 2.2923312³ × 0.068660978 = 3870.6860 W;
+  // charge motion 35.417596 kW; net = 1.26 × 35.417596 = 44.626171 kW.
+  const double gap = 1.0 - z * r_i;
+  const double potential = pi * 9.81 * n_m / (3.0 * gap) *
+                           (2.0 - 3.0 * z * r_i + r_i * r_i * r_i * (3.0 * z - 2.0)) * 4680.0 *
+                           drop;
+  const double kinetic = 4680.0 * std::pow(n_m * pi / gap, 3) *
+                         (std::pow(gap, 4) - std::pow(r_i, 4) * std::pow(z - 1.0, 4));
+  const MorrellPower m = morrell_power(in);
+  EXPECT_FORMULA(m.centrifuging_speed_fraction, 1.0374);
+  EXPECT_FORMULA(m.toe_angle, toe);
+  EXPECT_FORMULA(m.shoulder_angle, shoulder);
+  EXPECT_FORMULA(m.mean_radius, mean_radius);
+  EXPECT_FORMULA(m.active_fraction, beta);
+  EXPECT_FORMULA(m.inner_radius, r_i);
+  EXPECT_FORMULA(m.z, z);
+  EXPECT_FORMULA(m.charge_motion_kw, (potential + kinetic) / 1000.0);
+  EXPECT_FORMULA(m.net_kw, 1.26 * (potential + kinetic) / 1000.0);
+  EXPECT_NEAR(m.toe_angle, 3.7884133, 1e-7);
+  EXPECT_NEAR(m.shoulder_angle, 0.98870514, 1e-8);
+  EXPECT_NEAR(potential, 31546.910, 1e-3);
+  EXPECT_NEAR(kinetic, 3870.6860, 1e-3);
+  EXPECT_NEAR(m.net_kw, 44.626171, 1e-6);
+}
+
+TEST(EmpiricalPower, MorrellAboveCentrifugingSpeedHasToeAtRightAngle) {
+  // φ = 1.2 > 0.35 × (3.364 − 0.4) = 1.0374: φ_c = φ, the exponential term vanishes and
+  // θ_T = π/2, θ_S = π/2: the charge rides with the shell and lifts nothing.
+  EmpiricalPowerInputs in = round_mill();
+  in.speed_fraction = 1.2;
+  in.speed_rpm = 1.2 * in.shell_critical_speed_rpm;
+  const MorrellPower m = morrell_power(in);
+  EXPECT_EQ(m.centrifuging_speed_fraction, 1.2);
+  EXPECT_NEAR(m.toe_angle, pi / 2.0, 1e-15);
+  EXPECT_NEAR(m.shoulder_angle, pi / 2.0, 1e-15);
+}
+
+TEST(EmpiricalPower, PowerGrowsLinearlyWithLength) {
+  EmpiricalPowerInputs in = case_2d_g();
+  const EmpiricalPower one = empirical_power(in);
+  in.length *= 3.0;
+  in.ball_charge_mass *= 3.0;  // the charge is J of the (longer) mill
+  const EmpiricalPower three = empirical_power(in);
+  EXPECT_FORMULA(three.bond.power_kw, 3.0 * one.bond.power_kw);
+  EXPECT_FORMULA(three.hogg_fuerstenau.power_kw, 3.0 * one.hogg_fuerstenau.power_kw);
+  EXPECT_FORMULA(three.morrell.net_kw, 3.0 * one.morrell.net_kw);
+}
+
+TEST(EmpiricalPower, EmptyMillDrawsNothing) {
+  EmpiricalPowerInputs in = case_2d_g();
+  in.filling = 0.0;
+  in.ball_charge_mass = 0.0;
+  const EmpiricalPower p = empirical_power(in);
+  // Bond: kWb > 0 but no tonnes of balls; H–F: sin³θ = 0; Morrell: no charge.
+  EXPECT_GT(p.bond.kw_per_ball_tonne, 0.0);
+  EXPECT_EQ(p.bond.power_kw, 0.0);
+  EXPECT_EQ(p.hogg_fuerstenau.power_kw, 0.0);
+  EXPECT_EQ(p.morrell.net_kw, 0.0);
+  // And a nearly empty mill draws nearly nothing (no division by zero on the way).
+  in.filling = 1e-6;
+  in.ball_charge_mass = 4680.0 * 1e-6 * pi * 2.055 * 2.055 * 5.49;
+  const EmpiricalPower q = empirical_power(in);
+  EXPECT_LT(q.bond.power_kw, 1e-2);
+  EXPECT_LT(q.hogg_fuerstenau.power_kw, 1e-2);
+  EXPECT_GE(q.morrell.net_kw, 0.0);
+  EXPECT_LT(q.morrell.net_kw, 1e-2);
+}
+
+MillConfig validation_case(const std::string& name) {
+  return load_mill_config(
+      std::string(MILLSIM_SOURCE_DIR) + "/examples/validation/" + name + ".toml",
+      {"output.snapshot_interval=0"});
+}
+
+TEST(EmpiricalPower, InputsFromThePlanOfCase2Dg) {
+  const MillPlan plan = plan_mill(validation_case("2D-g"));
+  const EmpiricalPowerInputs in = empirical_power_inputs(plan);
+  EXPECT_EQ(in.diameter, 4.11);
+  EXPECT_EQ(in.length, 5.49);
+  EXPECT_EQ(in.filling, 0.34);
+  EXPECT_EQ(in.top_ball_diameter, 0.076);
+  EXPECT_EQ(in.ball_charge_mass, plan.mill_charge_mass);
+  // ρ_b = 7800 × 0.6 = 4680 kg/m³. Speed 0.77 of MODEL.md's N_c = 42.30/sqrt(4.11 − 0.076):
+  // 0.77 × 21.059945 = 16.215997 rpm; the shell's N_c = 9.5492966 × sqrt(19.62/4.11) =
+  // 20.864309 rpm, so φ = 16.215997/20.864309 = 0.77721950.
+  EXPECT_FORMULA(in.bed_density, 4680.0);
+  EXPECT_FORMULA(in.speed_rpm, 0.77 * 60.0 / (2.0 * pi) * std::sqrt(19.62 / (4.11 - 0.076)));
+  EXPECT_FORMULA(in.shell_critical_speed_rpm, 60.0 / (2.0 * pi) * std::sqrt(19.62 / 4.11));
+  EXPECT_FORMULA(in.speed_fraction, 0.77 * std::sqrt(4.11 / (4.11 - 0.076)));
+  EXPECT_NEAR(in.speed_fraction, 0.7772195, 1e-7);
+  EXPECT_NEAR(in.repose_angle, 35.0 * pi / 180.0, 1e-15);
+  // The three models for the measured mill (1324 kW measured): Bond 1463.4 kW,
+  // Hogg–Fuerstenau 1285.0 kW, Morrell net 1436.9 kW (regression values of the checks above).
+  const EmpiricalPower p = empirical_power(plan);
+  EXPECT_NEAR(p.bond.power_kw, 1463.44497, 1e-3);
+  EXPECT_NEAR(p.hogg_fuerstenau.power_kw, 1285.04465, 1e-3);
+  EXPECT_NEAR(p.morrell.net_kw, 1436.91989, 1e-3);
+}
+
+TEST(EmpiricalPower, SummaryJsonHasTheEmpiricalObjectAndEveryScalar) {
+  MillResult result;
+  result.plan = plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", {}));
+  result.power_kw = 0.5;
+  const std::string json = summary_json(result);
+  const EmpiricalPower p = empirical_power(result.plan);
+  const auto scalars = summary_scalars(result);
+  bool bond = false;
+  for (const auto& [name, value] : scalars) {
+    // "a.b.c" is written as "c" inside "b" inside "a": every part is a key of the JSON.
+    std::size_t start = 0;
+    for (std::size_t dot = name.find('.', start);; dot = name.find('.', start)) {
+      const std::string key = name.substr(start, dot - start);
+      EXPECT_NE(json.find("\"" + key + "\""), std::string::npos) << name;
+      if (dot == std::string::npos) break;
+      start = dot + 1;
+    }
+    if (name == "empirical.bond_kw") {
+      bond = true;
+      EXPECT_EQ(value, p.bond.power_kw);
+    } else if (name == "empirical.hogg_fuerstenau_kw") {
+      EXPECT_EQ(value, p.hogg_fuerstenau.power_kw);
+    } else if (name == "empirical.morrell_net_kw") {
+      EXPECT_EQ(value, p.morrell.net_kw);
+    }
+  }
+  EXPECT_TRUE(bond);
+  EXPECT_NE(json.find("\"empirical\""), std::string::npos);
+  EXPECT_NE(json.find("\"inputs\""), std::string::npos);
+}
+
+}  // namespace
+}  // namespace millsim
