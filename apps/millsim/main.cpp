@@ -1,21 +1,28 @@
 // millsim: the command-line program. `millsim --help` lists the commands.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <omp.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "millsim/builtin_example.hpp"
 #include "millsim/core/error.hpp"
 #include "millsim/io/config.hpp"
 #include "millsim/io/output.hpp"
+#include "millsim/measure/empirical_power.hpp"
 #include "millsim/sim/mill_run.hpp"
+#include "millsim/sim/scene_run.hpp"
+#include "millsim/sim/sweep.hpp"
 
 namespace {
 
@@ -43,6 +50,16 @@ MillConfig load(const JobOptions& options) {
   return millsim::load_mill_config(options.config_path, overrides);
 }
 
+/// A mill or a scene config (a file without [mill] is a scene).
+millsim::JobConfig load_job(const JobOptions& options) {
+  if (options.config_path.empty()) return load(options);
+  std::vector<std::string> overrides = options.overrides;
+  if (!options.output_directory.empty()) {
+    overrides.push_back(fmt::format("output.directory={}", options.output_directory));
+  }
+  return millsim::load_config(options.config_path, overrides);
+}
+
 /// A single progress line on stderr, redrawn in place; only when stderr is a terminal.
 class ProgressLine {
  public:
@@ -57,8 +74,11 @@ class ProgressLine {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     const double fraction = std::min(1.0, time / total);
     const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
-    fmt::print(stderr, "\r{:5.1f}%  t = {:.2f} of {:.2f} s  revolutions {:.2f}  ETA {:.0f} s   ",
-               100.0 * fraction, time, total, revolutions, eta);
+    // revolutions < 0: a scene, which has none.
+    const std::string turned =
+        revolutions >= 0.0 ? fmt::format("  revolutions {:.2f}", revolutions) : std::string();
+    fmt::print(stderr, "\r{:5.1f}%  t = {:.4g} of {:.4g} s{}  ETA {:.0f} s   ", 100.0 * fraction,
+               time, total, turned, eta);
     std::fflush(stderr);
     drawn_ = true;
   }
@@ -102,8 +122,39 @@ MillResult run_job(const MillConfig& config, bool show_progress) {
   return config.dimension == 2 ? run_job<2>(plan, show_progress) : run_job<3>(plan, show_progress);
 }
 
+/// Runs a scene (particles and walls, no mill): plans first so that a config that cannot run
+/// writes nothing.
+int run_scene_command(const millsim::SceneConfig& scene, const JobOptions& options) {
+  const millsim::ScenePlan plan = millsim::plan_scene(scene);
+  const std::filesystem::path out = scene.output_directory;
+  if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
+    throw millsim::InputError(fmt::format(
+        "{}: output.directory: \"{}\" exists and is not a directory; allowed: a directory path",
+        scene.location_of("output.directory"), scene.output_directory));
+  }
+  if (!options.quiet) fmt::print("millsim: running scene {}\n", scene.source);
+  std::filesystem::create_directories(out);
+  for (const char* name : {"summary.json", "trajectory.csv", "final.csv"}) {
+    std::filesystem::remove(out / name);
+  }
+  ProgressLine progress(!options.quiet);
+  const millsim::SceneResult result = millsim::run_scene(
+      plan, out, [&](double time, double total) { progress(time, total, -1.0); });
+  progress.clear();
+  fmt::print("{}\n", millsim::scene_summary_line(result));
+  if (!options.quiet) {
+    fmt::print("results in {}/ (summary.json, trajectory.csv, final.csv)\n",
+               scene.output_directory);
+  }
+  return 0;
+}
+
 int run_command(const JobOptions& options) {
-  const MillConfig config = load(options);
+  const millsim::JobConfig job = load_job(options);
+  if (const auto* scene = std::get_if<millsim::SceneConfig>(&job)) {
+    return run_scene_command(*scene, options);
+  }
+  const MillConfig& config = std::get<MillConfig>(job);
   if (!options.quiet) fmt::print("millsim: running {}\n", config.source);
   const MillResult result = run_job(config, !options.quiet);
   fmt::print("{}\n", millsim::summary_line(result));
@@ -114,8 +165,34 @@ int run_command(const JobOptions& options) {
   return 0;
 }
 
+int scene_info(const millsim::SceneConfig& scene) {
+  const millsim::ScenePlan plan = millsim::plan_scene(scene);
+  fmt::print("config                {}\n", scene.source);
+  fmt::print(
+      "scene                 {}D, {} particles, {} plane walls, gravity {}\n", scene.dimension,
+      scene.particles.size(), scene.walls.size(),
+      fmt::join(std::span(scene.gravity).first(static_cast<std::size_t>(scene.dimension)), ", "));
+  if (plan.shortest_contact > 0.0) {
+    fmt::print("shortest contact      {:.4g} s\n", plan.shortest_contact);
+    fmt::print("time step             {:.4g} s{} (stability limit {:.4g} s)\n", plan.time_step,
+               scene.time_step ? "" : " (auto)", plan.critical_time_step);
+  } else {
+    fmt::print("shortest contact      none (nothing can touch)\n");
+    fmt::print("time step             {:.4g} s{}\n", plan.time_step,
+               scene.time_step ? "" : " (auto: 1/1000 of the duration)");
+  }
+  const std::string rows = plan.trajectory_every > 0
+                               ? fmt::format("every {} steps", plan.trajectory_every)
+                               : std::string("start and end only");
+  fmt::print("simulated time        {:.4g} s: {} steps; trajectory rows {}\n", scene.duration,
+             plan.steps, rows);
+  return 0;
+}
+
 int info_command(const JobOptions& options) {
-  const MillPlan plan = millsim::plan_mill(load(options));
+  const millsim::JobConfig job = load_job(options);
+  if (const auto* scene = std::get_if<millsim::SceneConfig>(&job)) return scene_info(*scene);
+  const MillPlan plan = millsim::plan_mill(std::get<MillConfig>(job));
   const MillConfig& c = plan.config;
   fmt::print("config                {}\n", c.source);
   fmt::print("mill                  {} m x {} m, {} lifters {} x {} m (height x width)\n",
@@ -150,6 +227,10 @@ int info_command(const JobOptions& options) {
   const double steps = plan.total_time / plan.time_step;
   fmt::print("simulated time        {:.4g} s: settle {} s + {} revolutions; {:.3g} steps\n",
              plan.total_time, c.settle_time, c.revolutions, steps);
+  const millsim::EmpiricalPower empirical = millsim::empirical_power(plan);
+  fmt::print(
+      "empirical power       Bond {:.4g} kW, Hogg-Fuerstenau {:.4g} kW, Morrell net {:.4g} kW\n",
+      empirical.bond.power_kw, empirical.hogg_fuerstenau.power_kw, empirical.morrell.net_kw);
   return 0;
 }
 
@@ -197,6 +278,111 @@ int validate_command(const std::string& directory, const JobOptions& options) {
   return failures == 0 ? 0 : 1;
 }
 
+/// Reads every point's config and plans it before running any, so that a bad key or value
+/// refuses the whole sweep and writes nothing.
+std::vector<MillPlan> plan_sweep(const JobOptions& options,
+                                 const std::vector<millsim::SweepAxis>& axes,
+                                 const std::vector<std::vector<std::string>>& points,
+                                 const std::filesystem::path& root) {
+  std::vector<MillPlan> plans;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    JobOptions point = options;
+    point.output_directory.clear();
+    const std::vector<std::string> settings = millsim::point_overrides(axes, points[i]);
+    point.overrides.insert(point.overrides.end(), settings.begin(), settings.end());
+    try {
+      MillConfig config = load(point);
+      config.output_directory =
+          (root / millsim::point_directory_name(i, points.size(), axes, points[i])).string();
+      plans.push_back(millsim::plan_mill(config));
+    } catch (const millsim::InputError& error) {
+      throw millsim::InputError(
+          fmt::format("sweep point {} ({}): {}", i, fmt::join(settings, ", "), error.what()));
+    }
+  }
+  return plans;
+}
+
+/// Runs every planned point and returns its row. With at least as many points as threads the
+/// points run in parallel, one thread each (nesting is off, so the World's own parallel loops
+/// run serially) and without progress lines; otherwise one after another with every thread.
+/// The results are the same either way. A point that fails is reported in its row.
+std::vector<millsim::SweepRow> run_sweep(const std::vector<MillPlan>& plans,
+                                         const std::vector<millsim::SweepAxis>& axes,
+                                         const std::vector<std::vector<std::string>>& points,
+                                         bool quiet, bool parallel) {
+  std::vector<millsim::SweepRow> rows(points.size());
+  const auto run_point = [&](std::size_t i, bool show_progress) {
+    millsim::SweepRow& row = rows[i];
+    row.values = points[i];
+    try {
+      const MillPlan& plan = plans[i];
+      const MillResult result = plan.config.dimension == 2 ? run_job<2>(plan, show_progress)
+                                                           : run_job<3>(plan, show_progress);
+      row.status = "ok";
+      row.scalars = millsim::summary_scalars(result);
+    } catch (const std::exception& error) {
+      row.status = fmt::format("failed: {}", error.what());
+    }
+    if (quiet) return;
+#pragma omp critical(millsim_sweep_report)
+    fmt::print(stderr, "point {} of {} done ({}): {}\n", i, points.size(),
+               fmt::join(millsim::point_overrides(axes, points[i]), ", "), row.status);
+  };
+  if (!parallel) {
+    for (std::size_t i = 0; i < points.size(); ++i) run_point(i, !quiet);
+    return rows;
+  }
+  const int levels = omp_get_max_active_levels();
+  omp_set_max_active_levels(1);
+  const auto count = static_cast<std::ptrdiff_t>(points.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::ptrdiff_t i = 0; i < count; ++i) run_point(static_cast<std::size_t>(i), false);
+  omp_set_max_active_levels(levels);
+  return rows;
+}
+
+/// Runs the cartesian product of the --vary axes, one output directory per point, writes
+/// sweep.csv and prints a table. Exit status 1 if any point failed.
+int sweep_command(const JobOptions& options, const std::vector<std::string>& vary_arguments) {
+  std::vector<millsim::SweepAxis> axes;
+  for (const std::string& argument : vary_arguments) axes.push_back(millsim::parse_vary(argument));
+  millsim::check_sweep_axes(axes);
+  const std::vector<std::vector<std::string>> points = millsim::cartesian_product(axes);
+  const std::filesystem::path root =
+      options.output_directory.empty() ? "runs/sweep" : options.output_directory;
+  if (std::filesystem::exists(root) && !std::filesystem::is_directory(root)) {
+    throw millsim::InputError(fmt::format(
+        "command line (--out {}): exists and is not a directory; allowed: a directory path",
+        root.string()));
+  }
+  const std::vector<MillPlan> plans = plan_sweep(options, axes, points, root);
+  const int threads = omp_get_max_threads();
+  const bool parallel = threads > 1 && points.size() >= static_cast<std::size_t>(threads);
+  if (!options.quiet) {
+    fmt::print("millsim: sweeping {} points of {} into {}/ ({})\n", points.size(),
+               plans.front().config.source, root.string(),
+               parallel ? fmt::format("{} at a time", threads) : std::string("one at a time"));
+    std::fflush(stdout);
+  }
+  std::filesystem::create_directories(root);
+  const std::vector<millsim::SweepRow> rows =
+      run_sweep(plans, axes, points, options.quiet, parallel);
+  millsim::write_sweep_csv(root / "sweep.csv", axes, rows);
+
+  fmt::print("{}", millsim::sweep_table(axes, rows));
+  const auto failed = std::count_if(
+      rows.begin(), rows.end(), [](const millsim::SweepRow& row) { return row.status != "ok"; });
+  if (!options.quiet) {
+    fmt::print("results in {}/ (sweep.csv, one directory per point)\n", root.string());
+  }
+  if (failed > 0) {
+    fmt::print(stderr, "millsim: {} of {} points failed\n", failed, points.size());
+    return 1;
+  }
+  return 0;
+}
+
 void add_job_options(CLI::App& command, JobOptions& options) {
   command.add_option("--set", options.overrides,
                      "override a config key, e.g. --set mill.speed=0.75 (repeatable)");
@@ -235,6 +421,20 @@ int main(int argc, char** argv) {
                        "where the runs go (default runs/validation)");
   add_job_options(*validate, options);
 
+  std::vector<std::string> vary_arguments;
+  CLI::App* sweep = app.add_subcommand(
+      "sweep", "run a mill at every combination of varied keys and tabulate the results");
+  sweep->add_option("config", options.config_path,
+                    "mill config (TOML); default: the built-in example");
+  sweep
+      ->add_option("--vary", vary_arguments,
+                   "KEY=START:STOP:STEP or KEY=V1,V2,... (repeatable; the cartesian product runs)")
+      ->required()
+      ->allow_extra_args(false);
+  sweep->add_option("-o,--out", options.output_directory,
+                    "where the points and sweep.csv go (default runs/sweep)");
+  add_job_options(*sweep, options);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -247,6 +447,7 @@ int main(int argc, char** argv) {
   try {
     if (run->parsed()) return run_command(options);
     if (info->parsed()) return info_command(options);
+    if (sweep->parsed()) return sweep_command(options, vary_arguments);
     return validate_command(validation_directory, options);
   } catch (const millsim::InputError& error) {
     fmt::print(stderr, "millsim: error: {}\n", error.what());

@@ -330,8 +330,11 @@ std::string MillConfig::location_of(std::string_view dotted_key) const {
   return found != key_locations.end() ? found->second : source;
 }
 
-MillConfig parse_mill_config(std::string_view toml_text, const std::string& source,
-                             const std::vector<std::string>& overrides) {
+namespace {
+
+/// The TOML document of a config, with the overrides applied.
+toml::table parse_document(std::string_view toml_text, const std::string& source,
+                           const std::vector<std::string>& overrides) {
   toml::table document;
   try {
     document = toml::parse(toml_text, std::string_view(source));
@@ -342,12 +345,20 @@ MillConfig parse_mill_config(std::string_view toml_text, const std::string& sour
         source, error.source().begin.line, error.source().begin.column, error.description()));
   }
   apply_overrides(document, overrides);
+  return document;
+}
 
+MillConfig read_mill_config(const toml::table& document, const std::string& source) {
   MillConfig config;
   config.source = source;
   TableReader root(document, "", source, &config.key_locations);
   root.allow_keys({"simulation", "mill", "charge", "materials", "output", "reference"},
-                  belongs_elsewhere);
+                  [](std::string_view key) -> std::string {
+                    if (key == "particles" || key == "walls") {
+                      return "a scene's table; a scene config has no [mill]";
+                    }
+                    return belongs_elsewhere(key);
+                  });
   read_simulation(root.table("simulation", false), config);
   read_mill(root.table("mill", true,
                        "a table [mill] with diameter, length, speed or speed_rpm, and "
@@ -366,7 +377,233 @@ MillConfig parse_mill_config(std::string_view toml_text, const std::string& sour
   return config;
 }
 
-MillConfig load_mill_config(const std::string& path, const std::vector<std::string>& overrides) {
+// ---- scenes ----
+
+std::string scene_hint(std::string_view key) {
+  static constexpr std::string_view mill_only[] = {
+      "settle_time", "revolutions", "measure_revolutions", "seed",
+      "mill",        "charge",      "reference",           "snapshot_interval",
+  };
+  if (std::find(std::begin(mill_only), std::end(mill_only), key) != std::end(mill_only)) {
+    return "a mill key; a scene (a config without [mill]) does not use it";
+  }
+  return {};
+}
+
+/// "[x, y]" or "[x, y, z]" with the given names, for messages.
+std::string vector_rule(int dimension, std::string_view what) {
+  return dimension == 2 ? fmt::format("an array [x, y] of two numbers ({})", what)
+                        : fmt::format("an array [x, y, z] of three numbers ({})", what);
+}
+
+std::array<double, 3> read_vector(TableReader& table, std::string_view key, int dimension,
+                                  std::string_view what, bool required) {
+  std::optional<std::vector<double>> fallback;
+  if (!required) fallback = std::vector<double>(static_cast<std::size_t>(dimension), 0.0);
+  const std::vector<double> v = table.numbers(key, static_cast<std::size_t>(dimension), fallback,
+                                              vector_rule(dimension, what));
+  std::array<double, 3> out{};
+  std::copy(v.begin(), v.end(), out.begin());
+  return out;
+}
+
+void read_scene_simulation(TableReader section, SceneConfig& config) {
+  section.allow_keys({"dimension", "time_step", "duration", "gravity"}, scene_hint);
+  config.dimension = static_cast<int>(section.integer("dimension", 2, "2 (discs) or 3 (spheres)",
+                                                      [](long d) { return d == 2 || d == 3; }));
+  const std::string step_rule = "\"auto\" or a number of seconds > 0";
+  if (const toml::node* step = section.node("time_step")) {
+    if (step->is_string()) {
+      if (step->as_string()->get() != "auto") {
+        section.fail_at("time_step", fmt::format("{} is not allowed; allowed: {}",
+                                                 describe_value(*step), step_rule));
+      }
+    } else {
+      config.time_step = section.number("time_step", std::nullopt, step_rule, positive);
+    }
+  }
+  config.duration = section.number("duration", std::nullopt, "a number of seconds > 0, at most 1e4",
+                                   [](double t) { return t > 0.0 && t <= 1e4; });
+  std::vector<double> down(static_cast<std::size_t>(config.dimension), 0.0);
+  down.back() = -standard_gravity;
+  const std::vector<double> g =
+      section.numbers("gravity", static_cast<std::size_t>(config.dimension), down,
+                      vector_rule(config.dimension, "m/s2; default: -9.81 along the last axis"));
+  std::copy(g.begin(), g.end(), config.gravity.begin());
+}
+
+/// The entries of the array of tables `key` ([[particles]]), each with its reader.
+template <typename ReadOne>
+void read_table_array(TableReader& root, std::string_view key, std::string_view allowed,
+                      KeyLocations* locations, ReadOne&& read_one) {
+  const toml::node* list = root.node(key);
+  if (list == nullptr) return;
+  if (!list->is_array()) {
+    root.fail_at(key,
+                 fmt::format("{} is not allowed; allowed: {}", describe_value(*list), allowed));
+  }
+  int index = 0;
+  for (const toml::node& entry : *list->as_array()) {
+    const std::string name = fmt::format("{}[{}]", key, index++);
+    if (!entry.is_table()) {
+      root.fail_at_node(
+          entry, name,
+          fmt::format("{} is not allowed; allowed: {}", describe_value(entry), allowed));
+    }
+    read_one(TableReader(*entry.as_table(), name, root.file(), locations));
+  }
+}
+
+SceneParticle read_scene_particle(TableReader p, int dimension) {
+  p.allow_keys({"position", "velocity", "angular_velocity", "diameter", "density", "material"});
+  SceneParticle particle;
+  particle.position = read_vector(p, "position", dimension, "m", true);
+  particle.velocity = read_vector(p, "velocity", dimension, "m/s; default [0, 0...]", false);
+  if (dimension == 2) {
+    particle.angular_velocity[0] = p.number("angular_velocity", 0.0,
+                                            "a number of rad/s (the spin of a disc about the "
+                                            "out-of-plane axis, counter-clockwise positive)",
+                                            [](double) { return true; });
+  } else {
+    particle.angular_velocity =
+        read_vector(p, "angular_velocity", 3, "rad/s; default [0, 0, 0]", false);
+  }
+  particle.diameter = p.number("diameter", std::nullopt, "a number of metres > 0", positive);
+  particle.density = p.number("density", 7800.0, "a number of kg/m3 > 0 (default 7800)", positive);
+  const std::string material = p.string(
+      "material", "ball",
+      "\"ball\" (the particle material of [materials.ball_ball] and [materials.ball_wall])");
+  if (material != "ball") {
+    p.fail_at("material",
+              fmt::format("\"{}\" is not a material of this config; allowed: \"ball\" (the "
+                          "particle material of [materials.ball_ball] and [materials.ball_wall])",
+                          material));
+  }
+  return particle;
+}
+
+SceneWall read_scene_wall(TableReader w, int dimension) {
+  w.allow_keys({"point", "normal"});
+  SceneWall wall;
+  wall.point = read_vector(w, "point", dimension, "a point of the plane, m", true);
+  wall.normal =
+      read_vector(w, "normal", dimension, "not zero; points to the particles' side", true);
+  double length = 0.0;
+  for (const double x : wall.normal) length += x * x;
+  length = std::sqrt(length);
+  if (!(length > 0.0)) {
+    w.fail_at("normal",
+              fmt::format("a zero vector is not allowed; allowed: {}",
+                          vector_rule(dimension, "not zero; points to the particles' side")));
+  }
+  for (double& x : wall.normal) x /= length;
+  return wall;
+}
+
+/// Refuses particles that start inside a wall or overlapping each other: the incremental
+/// springs would start from zero at an overlap and the contact would be wrong.
+void check_scene_start(const SceneConfig& config) {
+  const std::size_t n = config.particles.size();
+  const auto name = [&](std::size_t i) {
+    return fmt::format("{}: particles[{}]",
+                       config.location_of(fmt::format("particles[{}].position", i)), i);
+  };
+  constexpr double slack = 1e-9;  // relative to the diameter: touching is allowed
+  for (std::size_t i = 0; i < n; ++i) {
+    const SceneParticle& p = config.particles[i];
+    const double r = 0.5 * p.diameter;
+    for (std::size_t k = 0; k < config.walls.size(); ++k) {
+      const SceneWall& w = config.walls[k];
+      double distance = 0.0;
+      for (int a = 0; a < config.dimension; ++a)
+        distance += (p.position[a] - w.point[a]) * w.normal[a];
+      if (distance < r * (1.0 - 2.0 * slack)) {
+        throw InputError(fmt::format(
+            "{}: starts {} walls[{}] (its centre is {:.6g} m from the plane, its radius {:.6g} "
+            "m); allowed: particles that start clear of every wall or just touching it",
+            name(i), distance < 0.0 ? "behind" : "overlapping", k, distance, r));
+      }
+    }
+  }
+  // Overlaps between particles: sweep along x.
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return config.particles[a].position[0] < config.particles[b].position[0];
+  });
+  double largest = 0.0;
+  for (const SceneParticle& p : config.particles) largest = std::max(largest, p.diameter);
+  for (std::size_t a = 0; a < n; ++a) {
+    const SceneParticle& p = config.particles[order[a]];
+    for (std::size_t b = a + 1; b < n; ++b) {
+      const SceneParticle& q = config.particles[order[b]];
+      if (q.position[0] - p.position[0] > largest) break;
+      double d2 = 0.0;
+      for (int k = 0; k < config.dimension; ++k)
+        d2 += (q.position[k] - p.position[k]) * (q.position[k] - p.position[k]);
+      const double reach = 0.5 * (p.diameter + q.diameter);
+      if (std::sqrt(d2) < reach * (1.0 - 2.0 * slack)) {
+        const std::size_t i = std::min(order[a], order[b]);
+        const std::size_t j = std::max(order[a], order[b]);
+        throw InputError(fmt::format(
+            "{} and particles[{}] overlap at the start (centres {:.6g} m apart, radii sum "
+            "{:.6g} m); allowed: particles that start apart or just touching",
+            name(i), j, std::sqrt(d2), reach));
+      }
+    }
+  }
+}
+
+SceneConfig read_scene_config(const toml::table& document, const std::string& source) {
+  SceneConfig config;
+  config.source = source;
+  TableReader root(document, "", source, &config.key_locations);
+  root.allow_keys({"simulation", "particles", "walls", "materials", "output"},
+                  [](std::string_view key) -> std::string {
+                    if (key == "charge" || key == "reference") {
+                      return "a mill table; this config has no [mill], so it is a scene";
+                    }
+                    return {};
+                  });
+  read_scene_simulation(root.table("simulation", true,
+                                   "a table [simulation] with duration (and dimension, "
+                                   "time_step, gravity)"),
+                        config);
+  const int d = config.dimension;
+  const std::string particle_rule = fmt::format(
+      "an array of tables [[particles]], each with position ({}), diameter, and optionally "
+      "velocity, angular_velocity, density, material",
+      d == 2 ? "[x, y]" : "[x, y, z]");
+  if (!root.has("particles")) root.fail_missing("particles", particle_rule);
+  read_table_array(root, "particles", particle_rule, &config.key_locations,
+                   [&](TableReader p) { config.particles.push_back(read_scene_particle(p, d)); });
+  if (config.particles.empty()) {
+    root.fail_at("particles", fmt::format("no particles; allowed: {}", particle_rule));
+  }
+  read_table_array(
+      root, "walls", "an array of tables [[walls]], each with point and normal (infinite planes)",
+      &config.key_locations, [&](TableReader w) { config.walls.push_back(read_scene_wall(w, d)); });
+  TableReader materials = root.table("materials", false);
+  materials.allow_keys({"ball_ball", "ball_wall"});
+  config.ball_ball = read_material(materials.table("ball_ball", false));
+  config.ball_wall = read_material(materials.table("ball_wall", false));
+  TableReader output = root.table("output", false);
+  output.allow_keys({"directory", "trajectory_interval"}, scene_hint);
+  const std::string directory_rule = "a directory path (a non-empty string)";
+  config.output_directory = output.string("directory", "out", directory_rule);
+  if (config.output_directory.empty()) {
+    output.fail_at("directory",
+                   fmt::format("an empty path is not allowed; allowed: {}", directory_rule));
+  }
+  config.trajectory_interval =
+      output.number("trajectory_interval", 0.0,
+                    "a number of seconds >= 0 (0 = only the start and the end in trajectory.csv)",
+                    [](double t) { return t >= 0.0; });
+  check_scene_start(config);
+  return config;
+}
+
+std::string read_config_file(const std::string& path) {
   const std::string allowed =
       "the path of a mill config file (TOML), e.g. examples/lab-mill-2d.toml";
   std::error_code error;
@@ -388,7 +625,48 @@ MillConfig load_mill_config(const std::string& path, const std::vector<std::stri
   if (file.bad()) {
     throw InputError(fmt::format("{}: cannot read the config file; allowed: {}", path, allowed));
   }
-  return parse_mill_config(text.str(), path, overrides);
+  return text.str();
+}
+
+bool is_scene(const toml::table& document) {
+  return !document.contains("mill");
+}
+
+}  // namespace
+
+std::string SceneConfig::location_of(std::string_view dotted_key) const {
+  const auto found = key_locations.find(dotted_key);
+  return found != key_locations.end() ? found->second : source;
+}
+
+MillConfig parse_mill_config(std::string_view toml_text, const std::string& source,
+                             const std::vector<std::string>& overrides) {
+  const toml::table document = parse_document(toml_text, source, overrides);
+  if (is_scene(document) && document.contains("particles")) {
+    throw InputError(fmt::format(
+        "{}: mill: missing required table [mill]: this is a scene config ([[particles]], no "
+        "[mill]); allowed: a mill config here (millsim run and info take scenes; sweep and "
+        "validate need a mill)",
+        source));
+  }
+  return read_mill_config(document, source);
+}
+
+MillConfig load_mill_config(const std::string& path, const std::vector<std::string>& overrides) {
+  return parse_mill_config(read_config_file(path), path, overrides);
+}
+
+JobConfig parse_config(std::string_view toml_text, const std::string& source,
+                       const std::vector<std::string>& overrides) {
+  const toml::table document = parse_document(toml_text, source, overrides);
+  if (is_scene(document) && (document.contains("particles") || document.contains("walls"))) {
+    return read_scene_config(document, source);
+  }
+  return read_mill_config(document, source);
+}
+
+JobConfig load_config(const std::string& path, const std::vector<std::string>& overrides) {
+  return parse_config(read_config_file(path), path, overrides);
 }
 
 }  // namespace millsim

@@ -321,6 +321,32 @@ long TableReader::integer(std::string_view key, std::optional<long> fallback,
   return value;
 }
 
+std::vector<double> TableReader::numbers(std::string_view key, std::size_t length,
+                                         std::optional<std::vector<double>> fallback,
+                                         std::string_view allowed) {
+  const toml::node* n = node(key);
+  if (n == nullptr) {
+    if (!fallback) fail_missing(key, allowed);
+    return *fallback;
+  }
+  const toml::array* array = n->as_array();
+  if (array == nullptr) fail_at(key, fmt::format("{}; allowed: {}", wrong_type(*n), allowed));
+  if (array->size() != length) {
+    fail_at(key, fmt::format("an array of {} values is not allowed; allowed: {}", array->size(),
+                             allowed));
+  }
+  std::vector<double> values;
+  for (const toml::node& element : *array) {
+    const std::optional<double> x = element.is_number() ? element.value<double>() : std::nullopt;
+    if (!x || !std::isfinite(*x)) {
+      fail_at(key, fmt::format("element {} is not a finite number; allowed: {}", describe(element),
+                               allowed));
+    }
+    values.push_back(*x);
+  }
+  return values;
+}
+
 bool TableReader::boolean(std::string_view key, bool fallback, std::string_view allowed) {
   const toml::node* n = node(key);
   if (n == nullptr) return fallback;

@@ -65,6 +65,11 @@ class TableReader {
   /// A string. A value given with --set is taken as the text typed even when it reads as
   /// another TOML value (--set output.directory=2024 names the directory "2024").
   bool boolean(std::string_view key, bool fallback, std::string_view allowed);
+  /// An array of exactly `length` finite numbers (integers accepted), e.g. a position
+  /// [0.0, 0.1, 0.02]. A missing key takes `fallback`, or is refused when there is none.
+  std::vector<double> numbers(std::string_view key, std::size_t length,
+                              std::optional<std::vector<double>> fallback,
+                              std::string_view allowed);
   std::string string(std::string_view key, std::optional<std::string> fallback,
                      std::string_view allowed);
   /// The sub-table `key`: an empty one if absent and not required. `allowed` describes the

@@ -1,0 +1,313 @@
+#include "millsim/sim/scene_run.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+
+#include "millsim/core/constants.hpp"
+#include "millsim/core/error.hpp"
+
+namespace millsim {
+namespace {
+
+/// Steps per contact duration of the "auto" time step, as for mills (plan_mill).
+constexpr double steps_per_contact = 20.0;
+/// "auto" for a scene whose particles can touch nothing: this many steps over the duration.
+constexpr double steps_without_contacts = 1000.0;
+
+double particle_mass(const SceneParticle& p) {
+  return p.density * pi * p.diameter * p.diameter * p.diameter / 6.0;
+}
+
+template <int D>
+Vec<D> to_vec(const std::array<double, 3>& a) {
+  Vec<D> v{};
+  for (int k = 0; k < D; ++k) v[k] = a[k];
+  return v;
+}
+
+template <int D>
+Spin<D> to_spin(const std::array<double, 3>& a) {
+  if constexpr (D == 2) {
+    return a[0];
+  } else {
+    return Vec3{a[0], a[1], a[2]};
+  }
+}
+
+/// One row of trajectory.csv or final.csv.
+template <int D>
+void write_row(std::FILE* file, double time, std::size_t id, const Vec<D>& x, const Vec<D>& v,
+               const Spin<D>& w) {
+  fmt::memory_buffer row;
+  fmt::format_to(std::back_inserter(row), "{:.17g},{}", time, id);
+  for (int k = 0; k < D; ++k) fmt::format_to(std::back_inserter(row), ",{:.17g}", x[k]);
+  for (int k = 0; k < D; ++k) fmt::format_to(std::back_inserter(row), ",{:.17g}", v[k]);
+  if constexpr (D == 2) {
+    fmt::format_to(std::back_inserter(row), ",{:.17g}\n", w);
+  } else {
+    fmt::format_to(std::back_inserter(row), ",{:.17g},{:.17g},{:.17g}\n", w[0], w[1], w[2]);
+  }
+  std::fwrite(row.data(), 1, row.size(), file);
+}
+
+/// Velocity and spin of particle i at the time of the positions: the half-step values moved on
+/// by half a step of the last step's acceleration (exact in free flight).
+template <int D>
+std::pair<Vec<D>, Spin<D>> current_motion(const World<D>& world, std::size_t i) {
+  const ParticleStore<D>& p = world.particles();
+  const double half = 0.5 * world.settings().time_step;
+  return {p.velocity[i] + (half * p.inverse_mass[i]) * p.force[i],
+          p.angular_velocity[i] + (half * p.inverse_inertia[i]) * p.torque[i]};
+}
+
+template <int D>
+void write_state(std::FILE* file, const World<D>& world) {
+  for (std::size_t i = 0; i < world.particles().size(); ++i) {
+    const auto [v, w] = current_motion(world, i);
+    write_row<D>(file, world.time(), i, world.particles().position[i], v, w);
+  }
+}
+
+template <int D>
+double kinetic_energy(const ParticleStore<D>& p, std::size_t i, const Vec<D>& v, const Spin<D>& w) {
+  if constexpr (D == 2) {
+    return 0.5 * p.mass[i] * dot(v, v) + 0.5 * w * w / p.inverse_inertia[i];
+  } else {
+    return 0.5 * p.mass[i] * dot(v, v) + 0.5 * dot(w, w) / p.inverse_inertia[i];
+  }
+}
+
+template <int D>
+std::string header() {
+  return D == 2 ? "time,id,x,y,vx,vy,w\n" : "time,id,x,y,z,vx,vy,vz,wx,wy,wz\n";
+}
+
+/// A file written under NAME.partial and renamed to NAME when closed complete.
+class OutputFile {
+ public:
+  explicit OutputFile(std::filesystem::path path)
+      : path_(std::move(path)), partial_(path_.string() + ".partial") {
+    file_ = std::fopen(partial_.c_str(), "wb");
+    if (file_ == nullptr) {
+      throw InputError(
+          fmt::format("{}: cannot write; allowed: a writable output directory", partial_.string()));
+    }
+  }
+  ~OutputFile() {
+    if (file_ != nullptr) {
+      std::fclose(file_);
+      std::filesystem::remove(partial_);
+    }
+  }
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+  std::FILE* get() { return file_; }
+  void write(const std::string& text) { std::fwrite(text.data(), 1, text.size(), file_); }
+  void commit() {
+    const bool failed = std::ferror(file_) != 0;
+    std::fclose(file_);
+    file_ = nullptr;
+    if (failed) {
+      std::filesystem::remove(partial_);
+      throw std::runtime_error(fmt::format("{}: write failed", path_.string()));
+    }
+    std::filesystem::rename(partial_, path_);
+  }
+
+ private:
+  std::filesystem::path path_;
+  std::filesystem::path partial_;
+  std::FILE* file_ = nullptr;
+};
+
+std::string summary_json(const SceneResult& r) {
+  const SceneConfig& c = r.plan.config;
+  std::string json = "{\n";
+  const auto add = [&](std::string_view key, const std::string& value, bool last = false) {
+    json += fmt::format("  \"{}\": {}{}\n", key, value, last ? "" : ",");
+  };
+  const auto number = [](double x) { return fmt::format("{:.17g}", x); };
+  add("kind", "\"scene\"");
+  add("config", fmt::format("\"{}\"", c.source));
+  add("dimension", fmt::format("{}", c.dimension));
+  add("particle_count", fmt::format("{}", c.particles.size()));
+  add("wall_count", fmt::format("{}", c.walls.size()));
+  add("time_step_s", number(r.plan.time_step));
+  add("critical_time_step_s", number(r.plan.critical_time_step));
+  add("shortest_contact_duration_s", number(r.plan.shortest_contact));
+  add("steps", fmt::format("{}", r.steps));
+  add("simulated_seconds", number(r.simulated_seconds));
+  add("wall_seconds", number(r.wall_seconds));
+  add("kinetic_energy_start_j", number(r.kinetic_start));
+  add("kinetic_energy_end_j", number(r.kinetic_end));
+  add("potential_energy_start_j", number(r.potential_start));
+  add("potential_energy_end_j", number(r.potential_end));
+  add("dissipated_j", number(r.dissipated));
+  add("ball_ball_collisions", fmt::format("{}", r.ball_ball_collisions));
+  add("ball_wall_collisions", fmt::format("{}", r.ball_wall_collisions), true);
+  return json + "}\n";
+}
+
+}  // namespace
+
+ScenePlan plan_scene(const SceneConfig& config) {
+  ScenePlan plan;
+  plan.config = config;
+  const double inertia = config.dimension == 2 ? 0.5 : 0.4;
+  std::vector<double> masses;
+  for (const SceneParticle& p : config.particles) masses.push_back(particle_mass(p));
+  std::sort(masses.begin(), masses.end());
+  double critical = std::numeric_limits<double>::infinity();
+  double shortest = std::numeric_limits<double>::infinity();
+  if (masses.size() >= 2) {
+    const double pair = reduced_mass(masses[0], masses[1]);
+    critical = std::min(
+        critical,
+        critical_time_step(config.ball_ball, pair, tangential_mass(masses[0], masses[1], inertia)));
+    shortest = std::min(shortest, contact_duration(config.ball_ball, pair));
+  }
+  if (!config.walls.empty()) {
+    critical = std::min(critical, critical_time_step(config.ball_wall, masses[0],
+                                                     tangential_mass(masses[0], 0.0, inertia)));
+    shortest = std::min(shortest, contact_duration(config.ball_wall, masses[0]));
+  }
+  plan.shortest_contact = std::isfinite(shortest) ? shortest : 0.0;
+  plan.critical_time_step = std::isfinite(critical) ? critical : 0.0;
+  if (config.time_step) {
+    if (std::isfinite(critical) && *config.time_step >= critical) {
+      throw InputError(fmt::format(
+          "{}: simulation.time_step: {:.4g} s is unstable for these particles and materials "
+          "(the shortest contact lasts {:.4g} s); allowed: a time step below the stability "
+          "limit {:.4g} s, and for accuracy about {:.4g} s (1/{} of the contact), or \"auto\"",
+          config.location_of("simulation.time_step"), *config.time_step, shortest, critical,
+          shortest / steps_per_contact, steps_per_contact));
+    }
+    plan.time_step = *config.time_step;
+  } else {
+    plan.time_step = std::isfinite(shortest) ? shortest / steps_per_contact
+                                             : config.duration / steps_without_contacts;
+  }
+  const double exact = config.duration / plan.time_step;
+  const double whole = std::round(exact);
+  plan.steps =
+      static_cast<long>(std::abs(exact - whole) <= 1e-9 * exact ? whole : std::ceil(exact));
+  constexpr double most_steps = 1e10;
+  if (static_cast<double>(plan.steps) > most_steps) {
+    throw InputError(fmt::format(
+        "{}: simulation.duration: {} s at a time step of {:.4g} s is {:.3g} steps; allowed: at "
+        "most {:.0e} steps (shorten the duration or lengthen the time step)",
+        config.location_of("simulation.duration"), config.duration, plan.time_step, exact,
+        most_steps));
+  }
+  if (config.trajectory_interval > 0.0) {
+    plan.trajectory_every =
+        std::max(1L, static_cast<long>(std::llround(config.trajectory_interval / plan.time_step)));
+  }
+  return plan;
+}
+
+template <int D>
+World<D> build_scene_world(const ScenePlan& plan) {
+  const SceneConfig& c = plan.config;
+  WorldSettings<D> settings;
+  settings.time_step = plan.time_step;
+  settings.gravity = to_vec<D>(c.gravity);
+  settings.ball_ball = c.ball_ball;
+  settings.ball_wall = c.ball_wall;
+  Walls<D> walls;
+  for (const SceneWall& w : c.walls)
+    walls.planes.push_back({to_vec<D>(w.point), to_vec<D>(w.normal)});
+  World<D> world(settings, walls);
+  for (const SceneParticle& p : c.particles) {
+    // u̇(−½) = u̇(0) − ½ g Δt: no contact force acts at the start (nothing overlaps).
+    const Vec<D> half_step_back = to_vec<D>(p.velocity) - (0.5 * plan.time_step) * settings.gravity;
+    world.particles().add(to_vec<D>(p.position), 0.5 * p.diameter, particle_mass(p), half_step_back,
+                          to_spin<D>(p.angular_velocity));
+  }
+  return world;
+}
+
+template <int D>
+SceneResult run_scene_in(const ScenePlan& plan, const std::filesystem::path& directory,
+                         const SceneProgress& progress) {
+  World<D> world = build_scene_world<D>(plan);
+  ImpactSpectrum spectrum;
+  world.record_collisions_in(&spectrum);
+  SceneResult result;
+  result.plan = plan;
+  const auto start_clock = std::chrono::steady_clock::now();
+  const ParticleStore<D>& p = world.particles();
+  const std::size_t n = p.size();
+
+  OutputFile trajectory(directory / "trajectory.csv");
+  trajectory.write(header<D>());
+  // At t = 0 the state of the config (the stored half-step velocities are set back by half a
+  // step of gravity).
+  for (std::size_t i = 0; i < n; ++i) {
+    const SceneParticle& sp = plan.config.particles[i];
+    const Vec<D> v = to_vec<D>(sp.velocity);
+    const Spin<D> w = to_spin<D>(sp.angular_velocity);
+    write_row<D>(trajectory.get(), 0.0, i, p.position[i], v, w);
+    result.kinetic_start += kinetic_energy(p, i, v, w);
+  }
+  result.potential_start = world.potential_energy();
+
+  const long report_every = std::max(1L, plan.steps / 200);
+  for (long step = 1; step <= plan.steps; ++step) {
+    world.step();
+    const bool last = step == plan.steps;
+    if (last || (plan.trajectory_every > 0 && step % plan.trajectory_every == 0)) {
+      write_state(trajectory.get(), world);
+    }
+    if (progress && step % report_every == 0) progress(world.time(), plan.config.duration);
+  }
+  OutputFile final_state(directory / "final.csv");
+  final_state.write(header<D>());
+  write_state(final_state.get(), world);
+
+  result.steps = world.steps();
+  result.simulated_seconds = world.time();
+  result.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_clock).count();
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto [v, w] = current_motion(world, i);
+    result.kinetic_end += kinetic_energy(p, i, v, w);
+  }
+  result.potential_end = world.potential_energy();
+  result.dissipated = world.energy_account().dissipated;
+  result.ball_ball_collisions = spectrum.total_count(ContactType::ball_ball);
+  result.ball_wall_collisions = spectrum.total_count(ContactType::ball_plane);
+
+  trajectory.commit();
+  final_state.commit();
+  OutputFile summary(directory / "summary.json");
+  summary.write(summary_json(result));
+  summary.commit();
+  return result;
+}
+
+SceneResult run_scene(const ScenePlan& plan, const std::filesystem::path& directory,
+                      const SceneProgress& progress) {
+  return plan.config.dimension == 2 ? run_scene_in<2>(plan, directory, progress)
+                                    : run_scene_in<3>(plan, directory, progress);
+}
+
+std::string scene_summary_line(const SceneResult& r) {
+  return fmt::format(
+      "scene: {} particles, {} walls, {:.4g} s in {} steps of {:.4g} s; collisions ball-ball {}, "
+      "ball-wall {}; kinetic energy {:.4g} J -> {:.4g} J, dissipated {:.4g} J; {:.2f} s wall",
+      r.plan.config.particles.size(), r.plan.config.walls.size(), r.simulated_seconds, r.steps,
+      r.plan.time_step, r.ball_ball_collisions, r.ball_wall_collisions, r.kinetic_start,
+      r.kinetic_end, r.dissipated, r.wall_seconds);
+}
+
+template World<2> build_scene_world<2>(const ScenePlan&);
+template World<3> build_scene_world<3>(const ScenePlan&);
+
+}  // namespace millsim

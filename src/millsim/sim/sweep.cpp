@@ -1,0 +1,322 @@
+#include "millsim/sim/sweep.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <set>
+#include <stdexcept>
+
+#include "millsim/core/error.hpp"
+
+namespace millsim {
+namespace {
+
+constexpr std::string_view vary_allowed =
+    "KEY=START:STOP:STEP (numbers; STEP not 0 and leading from START towards STOP) or "
+    "KEY=V1,V2,... (each a TOML value or text, as for --set), e.g. mill.speed=0.3:0.9:0.1 or "
+    "charge.filling=0.2,0.3,0.4";
+
+/// A range's values are counted as whole steps from START; STOP is included when it is within
+/// this fraction of a step of the last one (it rarely lands exactly: 0.3 + 6 × 0.1 ≠ 0.9).
+constexpr double stop_tolerance_steps = 1e-9;
+/// More decimals than a double can hold are noise.
+constexpr int max_decimals = 30;
+
+std::string_view trim(std::string_view text) {
+  const auto first = text.find_first_not_of(" \t");
+  if (first == std::string_view::npos) return {};
+  const auto last = text.find_last_not_of(" \t");
+  return text.substr(first, last - first + 1);
+}
+
+bool valid_key(std::string_view key) {
+  if (key.empty() || key.front() == '.' || key.back() == '.') return false;
+  if (key.find("..") != std::string_view::npos) return false;
+  return std::all_of(key.begin(), key.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-' || c == '.';
+  });
+}
+
+std::optional<double> read_number(std::string_view text) {
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  double value = 0.0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || error != std::errc() || end != text.data() + text.size() ||
+      !std::isfinite(value)) {
+    return std::nullopt;
+  }
+  return value;
+}
+
+std::vector<std::string> split(std::string_view text, char separator) {
+  std::vector<std::string> parts;
+  for (std::size_t start = 0;;) {
+    const auto at = text.find(separator, start);
+    parts.emplace_back(trim(text.substr(start, at == std::string_view::npos ? at : at - start)));
+    if (at == std::string_view::npos) return parts;
+    start = at + 1;
+  }
+}
+
+std::vector<std::string> range_values(const std::vector<std::string>& parts,
+                                      const std::string& where) {
+  const char* names[] = {"START", "STOP", "STEP"};
+  double number[3] = {};
+  for (int k = 0; k < 3; ++k) {
+    const std::optional<double> value = read_number(parts[k]);
+    if (!value) {
+      throw InputError(fmt::format("{}: {} \"{}\" is not a number; allowed: {}", where, names[k],
+                                   parts[k], vary_allowed));
+    }
+    number[k] = *value;
+  }
+  const auto [start, stop, step] = number;
+  if (step == 0.0) {
+    throw InputError(fmt::format("{}: STEP is 0; allowed: {}", where, vary_allowed));
+  }
+  const double steps = (stop - start) / step;
+  if (steps < -stop_tolerance_steps) {
+    throw InputError(fmt::format("{}: STEP {} leads away from STOP {}; allowed: {}", where,
+                                 parts[2], parts[1], vary_allowed));
+  }
+  const double last = std::floor(steps + stop_tolerance_steps * std::max(1.0, steps));
+  if (last + 1.0 > static_cast<double>(max_sweep_points)) {
+    throw InputError(fmt::format("{}: {:.3g} values; allowed: at most {} values", where, last + 1.0,
+                                 max_sweep_points));
+  }
+  const int decimals = std::max(decimal_places(parts[0]), decimal_places(parts[2]));
+  std::vector<std::string> values;
+  for (std::size_t i = 0; i <= static_cast<std::size_t>(last); ++i) {
+    values.push_back(decimal_text(start + static_cast<double>(i) * step, decimals));
+  }
+  return values;
+}
+
+/// A CSV field, quoted when it holds a separator, a quote or a line break (RFC 4180).
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  return quoted + "\"";
+}
+
+std::string csv_line(const std::vector<std::string>& cells) {
+  std::string line;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    if (k > 0) line += ',';
+    line += csv_field(cells[k]);
+  }
+  line += '\n';
+  return line;
+}
+
+std::optional<double> scalar(const SweepRow& row, std::string_view name) {
+  for (const auto& [key, value] : row.scalars) {
+    if (key == name) return value;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+SweepAxis parse_vary(std::string_view argument) {
+  const std::string where = fmt::format("command line (--vary {})", argument);
+  const auto equals = argument.find('=');
+  if (equals == std::string_view::npos) {
+    throw InputError(
+        fmt::format("{}: no '=' between the key and the values; allowed: {}", where, vary_allowed));
+  }
+  SweepAxis axis;
+  axis.key = std::string(trim(argument.substr(0, equals)));
+  if (!valid_key(axis.key)) {
+    throw InputError(fmt::format(
+        "{}: \"{}\" is not a key; allowed: names of letters, digits, _ and - joined by dots, "
+        "e.g. mill.speed",
+        where, axis.key));
+  }
+  if (axis.key == "output.directory") {
+    throw InputError(fmt::format(
+        "{}: output.directory is set per point by the sweep; allowed: any other key (--out "
+        "sets where the points go)",
+        where));
+  }
+  const std::string_view spec = trim(argument.substr(equals + 1));
+  if (spec.find(':') != std::string_view::npos) {
+    const std::vector<std::string> parts = split(spec, ':');
+    if (parts.size() != 3) {
+      throw InputError(fmt::format("{}: \"{}\" has {} parts separated by ':', not 3; allowed: {}",
+                                   where, spec, parts.size(), vary_allowed));
+    }
+    axis.values = range_values(parts, where);
+    return axis;
+  }
+  axis.values = split(spec, ',');
+  for (std::size_t i = 0; i < axis.values.size(); ++i) {
+    if (axis.values[i].empty()) {
+      throw InputError(fmt::format("{}: value {} of the list is empty; allowed: {}", where, i + 1,
+                                   vary_allowed));
+    }
+  }
+  return axis;
+}
+
+int decimal_places(std::string_view number) {
+  const auto exponent_at = number.find_first_of("eE");
+  int exponent = 0;
+  if (exponent_at != std::string_view::npos) {
+    std::string_view digits = number.substr(exponent_at + 1);
+    if (!digits.empty() && digits.front() == '+') digits.remove_prefix(1);
+    std::from_chars(digits.data(), digits.data() + digits.size(), exponent);
+    number = number.substr(0, exponent_at);
+  }
+  const auto point = number.find('.');
+  const int fraction =
+      point == std::string_view::npos ? 0 : static_cast<int>(number.size() - point - 1);
+  return std::clamp(fraction - exponent, 0, max_decimals);
+}
+
+std::string decimal_text(double value, int decimals) {
+  const std::string rounded = fmt::format("{:.{}f}", value, std::clamp(decimals, 0, max_decimals));
+  double exact = 0.0;
+  std::from_chars(rounded.data(), rounded.data() + rounded.size(), exact);
+  if (exact == 0.0) exact = 0.0;  // no "-0"
+  return fmt::format("{}", exact);
+}
+
+void check_sweep_axes(const std::vector<SweepAxis>& axes) {
+  double count = 1.0;
+  for (std::size_t k = 0; k < axes.size(); ++k) {
+    count *= static_cast<double>(axes[k].values.size());
+    for (std::size_t j = 0; j < k; ++j) {
+      if (axes[j].key == axes[k].key) {
+        throw InputError(fmt::format(
+            "command line (--vary {}=...): {} is varied twice; allowed: each key in one --vary",
+            axes[k].key, axes[k].key));
+      }
+    }
+  }
+  if (count > static_cast<double>(max_sweep_points)) {
+    throw InputError(fmt::format("command line (--vary): {:.3g} points; allowed: at most {}", count,
+                                 max_sweep_points));
+  }
+}
+
+std::vector<std::vector<std::string>> cartesian_product(const std::vector<SweepAxis>& axes) {
+  std::vector<std::vector<std::string>> points{{}};
+  for (const SweepAxis& axis : axes) {
+    std::vector<std::vector<std::string>> longer;
+    longer.reserve(points.size() * axis.values.size());
+    for (const auto& point : points) {
+      for (const std::string& value : axis.values) {
+        longer.push_back(point);
+        longer.back().push_back(value);
+      }
+    }
+    points = std::move(longer);
+  }
+  return points;
+}
+
+std::vector<std::string> point_overrides(const std::vector<SweepAxis>& axes,
+                                         const std::vector<std::string>& point) {
+  std::vector<std::string> overrides;
+  for (std::size_t k = 0; k < axes.size(); ++k) {
+    overrides.push_back(fmt::format("{}={}", axes[k].key, point[k]));
+  }
+  return overrides;
+}
+
+std::string point_directory_name(std::size_t index, std::size_t count,
+                                 const std::vector<SweepAxis>& axes,
+                                 const std::vector<std::string>& point) {
+  const std::size_t width = std::max<std::size_t>(3, fmt::format("{}", count - 1).size());
+  std::string name = fmt::format("{:0{}d}", index, width);
+  for (const std::string& setting : point_overrides(axes, point)) {
+    name += '_';
+    for (const char c : setting) {
+      const bool safe = std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '.' || c == '+' ||
+                        c == '-' || c == '=' || c == '_';
+      name += safe ? c : '_';
+    }
+  }
+  return name;
+}
+
+std::string sweep_csv(const std::vector<SweepAxis>& axes, const std::vector<SweepRow>& rows) {
+  std::vector<std::string> names;
+  std::set<std::string, std::less<>> seen;
+  for (const SweepRow& row : rows) {
+    for (const auto& entry : row.scalars) {
+      if (seen.insert(entry.first).second) names.push_back(entry.first);
+    }
+  }
+  std::vector<std::string> header{"point"};
+  for (const SweepAxis& axis : axes) header.push_back(axis.key);
+  header.emplace_back("status");
+  header.insert(header.end(), names.begin(), names.end());
+  std::string text = csv_line(header);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const SweepRow& row = rows[i];
+    std::map<std::string_view, double, std::less<>> values;
+    for (const auto& [name, value] : row.scalars) values.emplace(name, value);
+    std::vector<std::string> cells{fmt::format("{}", i)};
+    cells.insert(cells.end(), row.values.begin(), row.values.end());
+    cells.push_back(row.status);
+    for (const std::string& name : names) {
+      const auto found = values.find(name);
+      cells.push_back(found == values.end() ? std::string() : fmt::format("{}", found->second));
+    }
+    text += csv_line(cells);
+  }
+  return text;
+}
+
+void write_sweep_csv(const std::filesystem::path& path, const std::vector<SweepAxis>& axes,
+                     const std::vector<SweepRow>& rows) {
+  const std::filesystem::path partial = path.string() + ".partial";
+  {
+    std::ofstream file(partial, std::ios::binary);
+    file << sweep_csv(axes, rows);
+    file.close();
+    if (!file) throw std::runtime_error(fmt::format("{}: cannot write", partial.string()));
+  }
+  std::filesystem::rename(partial, path);
+}
+
+std::string sweep_table(const std::vector<SweepAxis>& axes, const std::vector<SweepRow>& rows) {
+  constexpr const char* measures[] = {"power_kw", "power_dissipation_kw", "energy_balance_error"};
+  std::vector<std::size_t> widths;
+  for (std::size_t k = 0; k < axes.size(); ++k) {
+    std::size_t width = axes[k].key.size();
+    for (const SweepRow& row : rows) width = std::max(width, row.values[k].size());
+    widths.push_back(width);
+  }
+  std::string text;
+  for (std::size_t k = 0; k < axes.size(); ++k) {
+    text += fmt::format("{:<{}}  ", axes[k].key, widths[k]);
+  }
+  for (const char* measure : measures) text += fmt::format("{:>{}}  ", measure, 20);
+  text += "status\n";
+  for (const SweepRow& row : rows) {
+    for (std::size_t k = 0; k < axes.size(); ++k) {
+      text += fmt::format("{:<{}}  ", row.values[k], widths[k]);
+    }
+    for (const char* measure : measures) {
+      const std::optional<double> value = scalar(row, measure);
+      text += value ? fmt::format("{:>20.4g}  ", *value) : fmt::format("{:>20}  ", "-");
+    }
+    text += row.status + "\n";
+  }
+  return text;
+}
+
+}  // namespace millsim

@@ -1,0 +1,80 @@
+// A parameter sweep (`millsim sweep`): the varied keys and their values, the cartesian product
+// of them, a directory name per point, and the sweep.csv table. Pure functions; running the
+// points is the program's job.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace millsim {
+
+/// One `--vary KEY=SPEC`: a config key and the values it takes, as the TOML text given to the
+/// config like a `--set KEY=VALUE` override.
+struct SweepAxis {
+  std::string key;
+  std::vector<std::string> values;
+};
+
+/// The most points one axis or a whole sweep may have (a guard against a mistyped step).
+inline constexpr std::size_t max_sweep_points = 10000;
+
+/// Reads `KEY=START:STOP:STEP` (START, START + STEP, ... up to STOP, which is included within
+/// a rounding tolerance; each value is START + i STEP, not a running sum) or `KEY=V1,V2,...`
+/// (each value TOML, or text, as for --set). Throws InputError naming the argument and what is
+/// allowed.
+SweepAxis parse_vary(std::string_view argument);
+
+/// Decimal places a number needs as written: "0.25" 2, "3" 0, "2.5e-4" 5, "1e3" 0.
+int decimal_places(std::string_view number);
+
+/// `value` rounded to `decimals` places and written in the fewest digits that read back as
+/// that rounded value: (0.3 + 4 × 0.1, 1) gives "0.7", not "0.7000000000000001".
+std::string decimal_text(double value, int decimals);
+
+/// Throws InputError when two axes vary the same key or the sweep has more than
+/// max_sweep_points points.
+void check_sweep_axes(const std::vector<SweepAxis>& axes);
+
+/// Every combination of the axes' values, one value per axis in axis order; the first axis
+/// varies slowest (as nested loops written in the order of the --vary options).
+std::vector<std::vector<std::string>> cartesian_product(const std::vector<SweepAxis>& axes);
+
+/// The `--set`-style overrides of one point: "KEY=VALUE" for each axis.
+std::vector<std::string> point_overrides(const std::vector<SweepAxis>& axes,
+                                         const std::vector<std::string>& point);
+
+/// The directory of point `index` of `count`: the zero-padded index (at least 3 digits), then
+/// `_KEY=VALUE` per axis, with every character other than letters, digits and `.+-=_` made
+/// `_`, e.g. "007_mill.speed=0.7_charge.filling=0.3". The index makes names unique.
+std::string point_directory_name(std::size_t index, std::size_t count,
+                                 const std::vector<SweepAxis>& axes,
+                                 const std::vector<std::string>& point);
+
+/// The outcome of one point: its values, "ok" or "failed: message", and (when it ran) every
+/// scalar of its summary in summary_scalars order.
+struct SweepRow {
+  std::vector<std::string> values;
+  std::string status;
+  std::vector<std::pair<std::string, double>> scalars;
+};
+
+/// sweep.csv: a header `point, <each key>, status, <each scalar name>`, then one row per point.
+/// The scalar columns are the names of all rows in order of first appearance; a row without a
+/// scalar (a failed point) leaves its cell empty. Fields with a comma, quote or line break are
+/// quoted (RFC 4180).
+std::string sweep_csv(const std::vector<SweepAxis>& axes, const std::vector<SweepRow>& rows);
+
+/// Writes sweep_csv(axes, rows) to `path` under a temporary name (`path`.partial) and renames
+/// it, so that a half-written file never appears. Throws std::runtime_error if it cannot.
+void write_sweep_csv(const std::filesystem::path& path, const std::vector<SweepAxis>& axes,
+                     const std::vector<SweepRow>& rows);
+
+/// The table printed at the end of a sweep: the varied values, power_kw,
+/// power_dissipation_kw, energy_balance_error and the status of each point.
+std::string sweep_table(const std::vector<SweepAxis>& axes, const std::vector<SweepRow>& rows);
+
+}  // namespace millsim

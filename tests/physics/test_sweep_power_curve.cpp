@@ -1,0 +1,196 @@
+// `millsim sweep` on a small 2D mill (tests/data/sweep-small-mill.toml): the power-versus-speed
+// curve a mill engineer expects, rising to a peak below critical speed and falling as the
+// charge centrifuges; and the sweep's bookkeeping (thread independence, failed points, refused
+// input). Each test runs the built program in a fresh temporary directory.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string small_mill =
+    std::string(MILLSIM_SOURCE_DIR) + "/tests/data/sweep-small-mill.toml";
+
+/// A run of a second of simulated time or less, for the bookkeeping tests.
+constexpr const char* tiny_run =
+    " --set simulation.revolutions=1 --set simulation.measure_revolutions=1"
+    " --set simulation.settle_time=0.01 --set mill.speed=1.5";
+
+std::string quoted(const std::string& text) {
+  std::string out = "'";
+  for (const char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string read_all(const fs::path& path) {
+  std::ifstream file(path);
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+/// The fields of one CSV line (RFC 4180 quoting).
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> fields(1);
+  bool in_quotes = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (in_quotes && c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+      fields.back() += '"';
+      ++i;
+    } else if (c == '"') {
+      in_quotes = !in_quotes;
+    } else if (c == ',' && !in_quotes) {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
+/// sweep.csv as one map from column name to cell per point.
+std::vector<std::map<std::string, std::string>> read_csv(const fs::path& path) {
+  std::ifstream file(path);
+  std::string line;
+  std::getline(file, line);
+  const std::vector<std::string> header = csv_fields(line);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(file, line)) {
+    const std::vector<std::string> cells = csv_fields(line);
+    EXPECT_EQ(cells.size(), header.size()) << line;
+    auto& row = rows.emplace_back();
+    for (std::size_t k = 0; k < std::min(cells.size(), header.size()); ++k) {
+      row[header[k]] = cells[k];
+    }
+  }
+  return rows;
+}
+
+struct Outcome {
+  int status = -1;
+  std::string out;
+  std::string err;
+};
+
+class SweepPowerCurve : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "millsim-sweep-XXXXXX").string();
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+    root_ = pattern;
+    work_ = root_ / "work";
+    fs::create_directory(work_);
+  }
+  void TearDown() override {
+    std::error_code ignored;
+    fs::remove_all(root_, ignored);
+  }
+
+  /// Runs `millsim ARGS` in the working directory; ARGS is shell text.
+  Outcome millsim(const std::string& args) const {
+    const std::string command = "cd " + quoted(work_.string()) + " && " + quoted(MILLSIM_BINARY) +
+                                " " + args + " >" + quoted((root_ / "stdout").string()) + " 2>" +
+                                quoted((root_ / "stderr").string()) + " </dev/null";
+    const int raw = std::system(command.c_str());
+    Outcome o;
+    o.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    o.out = read_all(root_ / "stdout");
+    o.err = read_all(root_ / "stderr");
+    return o;
+  }
+
+  fs::path root_;
+  fs::path work_;
+};
+
+TEST_F(SweepPowerCurve, PowerRisesToAPeakBelowCriticalAndFallsAsTheChargeCentrifuges) {
+  const Outcome o =
+      millsim("sweep " + quoted(small_mill) + " --vary mill.speed=0.5:2.0:0.25 -q --out speed");
+  ASSERT_EQ(o.status, 0) << o.err;
+  const auto rows = read_csv(work_ / "speed" / "sweep.csv");
+  ASSERT_EQ(rows.size(), 7u);
+  std::vector<double> speed;
+  std::vector<double> power;
+  for (const auto& row : rows) {
+    ASSERT_EQ(row.at("status"), "ok");
+    speed.push_back(std::stod(row.at("mill.speed")));
+    power.push_back(std::stod(row.at("power_kw")));
+  }
+  std::string curve;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    curve += std::to_string(speed[i]) + " " + std::to_string(power[i]) + " kW\n";
+  }
+  const auto peak = static_cast<std::size_t>(
+      std::distance(power.begin(), std::max_element(power.begin(), power.end())));
+  EXPECT_GT(peak, 0u) << curve;
+  EXPECT_LT(peak, rows.size() - 1) << curve;
+  EXPECT_LT(speed[peak], 1.0) << curve;
+  EXPECT_LT(power.front(), power[peak]) << curve;
+  EXPECT_GE(speed.back(), 1.3);
+  EXPECT_LT(power.back(), 0.3 * power[peak]) << curve;
+}
+
+TEST_F(SweepPowerCurve, ResultsDoNotDependOnTheThreadsAndEveryPointHasItsDirectory) {
+  const std::string sweep = "sweep " + quoted(small_mill) +
+                            " --vary mill.speed=1.5,2 --vary charge.filling=0.2,0.3 -q" + tiny_run;
+  const Outcome serial = millsim(sweep + " -j 1 --out one");
+  const Outcome parallel = millsim(sweep + " -j 2 --out two");
+  ASSERT_EQ(serial.status, 0) << serial.err;
+  ASSERT_EQ(parallel.status, 0) << parallel.err;
+  const auto one = read_csv(work_ / "one" / "sweep.csv");
+  const auto two = read_csv(work_ / "two" / "sweep.csv");
+  ASSERT_EQ(one.size(), 4u);
+  ASSERT_EQ(two.size(), 4u);
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    for (const auto& [column, cell] : one[i]) {
+      if (column == "wall_seconds" || column == "particle_steps_per_second") continue;
+      EXPECT_EQ(cell, two[i].at(column)) << "point " << i << ", " << column;
+    }
+  }
+  EXPECT_EQ(one[1].at("mill.speed"), "1.5");
+  EXPECT_EQ(one[1].at("charge.filling"), "0.3");
+  EXPECT_TRUE(fs::exists(work_ / "two" / "001_mill.speed=1.5_charge.filling=0.3" / "summary.json"));
+  EXPECT_FALSE(fs::exists(work_ / "two" / "sweep.csv.partial"));
+}
+
+TEST_F(SweepPowerCurve, AFailedPointIsReportedAndTheOthersStillRun) {
+  // A filling of 0.95 passes the config checks but its discs do not fit when placed.
+  const Outcome o = millsim("sweep " + quoted(small_mill) +
+                            " --vary charge.filling=0.2,0.95,0.3 -q --out f" + tiny_run);
+  EXPECT_EQ(o.status, 1) << o.err;
+  EXPECT_NE(o.err.find("1 of 3 points failed"), std::string::npos) << o.err;
+  const auto rows = read_csv(work_ / "f" / "sweep.csv");
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0].at("status"), "ok");
+  EXPECT_TRUE(rows[1].at("status").starts_with("failed: ")) << rows[1].at("status");
+  EXPECT_EQ(rows[1].at("power_kw"), "");
+  EXPECT_EQ(rows[2].at("status"), "ok");
+  EXPECT_NE(o.out.find("failed: "), std::string::npos) << o.out;
+}
+
+TEST_F(SweepPowerCurve, ABadKeyOrSpecRefusesTheWholeSweepAndWritesNothing) {
+  const Outcome key = millsim("sweep " + quoted(small_mill) + " --vary mill.sped=0.3,0.5 --out s");
+  EXPECT_EQ(key.status, 2);
+  EXPECT_NE(key.err.find("mill.sped: unknown key"), std::string::npos) << key.err;
+  const Outcome value = millsim("sweep " + quoted(small_mill) + " --vary mill.speed=0.5,9 --out s");
+  EXPECT_EQ(value.status, 2);
+  EXPECT_NE(value.err.find("sweep point 1 (mill.speed=9)"), std::string::npos) << value.err;
+  const Outcome spec = millsim("sweep --vary mill.speed=0.3:0.9 --out s");
+  EXPECT_EQ(spec.status, 2);
+  EXPECT_NE(spec.err.find("command line (--vary mill.speed=0.3:0.9)"), std::string::npos)
+      << spec.err;
+  EXPECT_NE(spec.err.find("allowed: KEY=START:STOP:STEP"), std::string::npos) << spec.err;
+  EXPECT_FALSE(fs::exists(work_ / "s"));
+}
+
+}  // namespace

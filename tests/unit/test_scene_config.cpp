@@ -1,0 +1,232 @@
+// Scene configs (no [mill]: particles and plane walls): what is read, the defaults, and the
+// refusals, each naming the file, line and key and what is allowed.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <string>
+#include <string_view>
+#include <variant>
+
+#include "millsim/core/error.hpp"
+#include "millsim/io/config.hpp"
+#include "millsim/sim/scene_run.hpp"
+
+namespace {
+
+using millsim::SceneConfig;
+
+constexpr std::string_view drop = R"([simulation]
+dimension = 3
+time_step = 1e-6
+duration = 0.01
+
+[[particles]]
+position = [0.0, 0.0, 0.0105]
+velocity = [3.0, 0.0, -2.0]
+angular_velocity = [0.0, 0.0, 0.0]
+diameter = 0.02
+density = 4000
+material = "ball"
+
+[[walls]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 2.0]
+
+[materials.ball_wall]
+normal_stiffness = 1e6
+
+[output]
+directory = "out"
+trajectory_interval = 1e-5
+)";
+
+SceneConfig scene(std::string_view text, std::initializer_list<std::string> overrides = {}) {
+  const millsim::JobConfig job = millsim::parse_config(text, "drop.toml", overrides);
+  EXPECT_TRUE(std::holds_alternative<SceneConfig>(job));
+  return std::get<SceneConfig>(job);
+}
+
+/// The config is refused with a message holding every part.
+void expect_refused(std::string_view text, std::initializer_list<std::string> overrides,
+                    std::initializer_list<std::string_view> parts) {
+  try {
+    millsim::plan_scene(scene(text, overrides));
+    ADD_FAILURE() << "accepted";
+  } catch (const millsim::InputError& error) {
+    const std::string message = error.what();
+    for (const std::string_view part : parts) {
+      EXPECT_NE(message.find(part), std::string::npos)
+          << "message lacks \"" << part << "\":\n  " << message;
+    }
+  }
+}
+
+TEST(SceneConfig, ReadsTheExampleOfTheReadme) {
+  const SceneConfig c = scene(drop);
+  EXPECT_EQ(c.dimension, 3);
+  ASSERT_EQ(c.particles.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.particles[0].position[2], 0.0105);
+  EXPECT_DOUBLE_EQ(c.particles[0].velocity[0], 3.0);
+  EXPECT_DOUBLE_EQ(c.particles[0].density, 4000.0);
+  ASSERT_EQ(c.walls.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.walls[0].normal[2], 1.0) << "the normal is made a unit vector";
+  EXPECT_DOUBLE_EQ(c.ball_wall.normal_stiffness, 1e6);
+  EXPECT_DOUBLE_EQ(c.gravity[2], -9.81) << "gravity is on by default";
+  EXPECT_DOUBLE_EQ(c.trajectory_interval, 1e-5);
+  const millsim::ScenePlan plan = millsim::plan_scene(c);
+  EXPECT_EQ(plan.steps, 10000);
+  EXPECT_EQ(plan.trajectory_every, 10);
+}
+
+TEST(SceneConfig, AMillConfigIsStillAMill) {
+  const millsim::JobConfig job = millsim::parse_config(
+      "[mill]\ndiameter = 0.9\nlength = 0.15\nspeed = 0.5\n[charge]\nfilling = 0.3\n"
+      "ball_diameter = 0.05\n",
+      "mill.toml");
+  EXPECT_TRUE(std::holds_alternative<millsim::MillConfig>(job));
+}
+
+TEST(SceneConfig, TwoDimensionalScenesTakeTwoVectorsAndAScalarSpin) {
+  const SceneConfig c = scene(
+      "[simulation]\nduration = 0.1\n[[particles]]\nposition = [0.0, 0.5]\n"
+      "angular_velocity = 3.0\ndiameter = 0.02\n");
+  EXPECT_EQ(c.dimension, 2);
+  EXPECT_DOUBLE_EQ(c.gravity[1], -9.81);
+  EXPECT_DOUBLE_EQ(c.particles[0].angular_velocity[0], 3.0);
+  EXPECT_DOUBLE_EQ(c.particles[0].density, 7800.0);
+  const millsim::ScenePlan plan = millsim::plan_scene(c);
+  EXPECT_EQ(plan.steps, 1000) << "nothing to touch: 1000 steps over the duration";
+}
+
+TEST(SceneConfig, AutoTimeStepIsATwentiethOfTheShortestContact) {
+  std::string text(drop);
+  text.replace(text.find("time_step = 1e-6"), 16, "time_step = \"auto\"");
+  const millsim::ScenePlan plan = millsim::plan_scene(scene(text));
+  EXPECT_DOUBLE_EQ(plan.time_step, plan.shortest_contact / 20.0);
+  EXPECT_LT(plan.time_step, plan.critical_time_step);
+}
+
+TEST(SceneConfig, RefusesAnUnstableTimeStepAndGivesTheLimit) {
+  expect_refused(drop, {"simulation.time_step=1e-3"},
+                 {"simulation.time_step", "unstable", "stability limit"});
+}
+
+TEST(SceneConfig, RefusesAMillKeyInAScene) {
+  expect_refused(std::string(drop) + "\n", {"simulation.settle_time=1"},
+                 {"simulation.settle_time", "unknown key", "a mill key"});
+}
+
+TEST(SceneConfig, RefusesAVectorOfTheWrongLength) {
+  std::string text(drop);
+  text.replace(text.find("[3.0, 0.0, -2.0]"), 16, "[3.0, -2.0]");
+  expect_refused(text, {}, {"drop.toml:8", "particles[0].velocity", "2 values", "[x, y, z]"});
+}
+
+TEST(SceneConfig, RefusesANonNumberInAVector) {
+  std::string text(drop);
+  text.replace(text.find("[3.0, 0.0, -2.0]"), 16, "[3.0, \"a\", -2.0]");
+  expect_refused(text, {}, {"particles[0].velocity", "not a finite number"});
+}
+
+TEST(SceneConfig, RefusesAnUnknownKeyOfAParticle) {
+  std::string text(drop);
+  text.replace(text.find("density = 4000"), 14, "densty = 4000");
+  expect_refused(text, {}, {"drop.toml:11", "particles[0].densty", "did you mean density"});
+}
+
+TEST(SceneConfig, RefusesAMissingDurationAndAMissingDiameter) {
+  std::string text(drop);
+  text.replace(text.find("duration = 0.01"), 15, "");
+  expect_refused(text, {}, {"simulation.duration", "missing required key"});
+  text = drop;
+  text.replace(text.find("diameter = 0.02"), 15, "");
+  expect_refused(text, {}, {"particles[0].diameter", "missing required key"});
+}
+
+TEST(SceneConfig, RefusesAnUnknownMaterial) {
+  std::string text(drop);
+  text.replace(text.find("\"ball\""), 6, "\"rock\"");
+  expect_refused(text, {},
+                 {"drop.toml:12", "particles[0].material", "\"rock\"", "allowed: \"ball\""});
+}
+
+TEST(SceneConfig, RefusesAZeroWallNormal) {
+  std::string text(drop);
+  text.replace(text.find("[0.0, 0.0, 2.0]"), 15, "[0.0, 0.0, 0.0]");
+  expect_refused(text, {}, {"walls[0].normal", "zero vector"});
+}
+
+TEST(SceneConfig, RefusesAParticleStartingInsideAWall) {
+  std::string text(drop);
+  text.replace(text.find("0.0105"), 6, "0.005");
+  expect_refused(text, {}, {"drop.toml:7", "particles[0]", "overlapping walls[0]"});
+}
+
+TEST(SceneConfig, RefusesParticlesThatOverlapAtTheStart) {
+  const std::string text =
+      std::string(drop) + "\n[[particles]]\nposition = [0.015, 0.0, 0.0105]\ndiameter = 0.02\n";
+  expect_refused(text, {}, {"particles[0]", "particles[1] overlap"});
+}
+
+TEST(SceneConfig, RefusesAConfigWithoutParticlesOrMill) {
+  expect_refused("[simulation]\nduration = 1\n[[walls]]\npoint = [0, 0]\nnormal = [0, 1]\n", {},
+                 {"particles", "missing required"});
+}
+
+TEST(SceneConfig, AMillCommandRefusesASceneClearly) {
+  try {
+    millsim::parse_mill_config(drop, "drop.toml");
+    ADD_FAILURE() << "accepted";
+  } catch (const millsim::InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("this is a scene config"), std::string::npos)
+        << error.what();
+  }
+}
+
+/// Runs `millsim ARGS` in `directory`; returns the exit status.
+int millsim_in(const std::filesystem::path& directory, const std::string& args) {
+  const std::string command = "cd \"" + directory.string() + "\" && \"" + MILLSIM_BINARY + "\" " +
+                              args + " >/dev/null 2>stderr.txt";
+  const int raw = std::system(command.c_str());
+  return raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+}
+
+TEST(SceneRun, WritesTrajectoryFinalAndSummaryAndNothingPartial) {
+  namespace fs = std::filesystem;
+  std::string pattern = (fs::temp_directory_path() / "millsim-scene-XXXXXX").string();
+  ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+  const fs::path work = pattern;
+  std::ofstream(work / "drop.toml") << drop;
+  ASSERT_EQ(millsim_in(work, "run drop.toml -q --out out"), 0);
+  for (const char* name : {"trajectory.csv", "final.csv", "summary.json"}) {
+    EXPECT_TRUE(fs::exists(work / "out" / name)) << name;
+  }
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(work / "out")) {
+    ++files;
+    EXPECT_NE(entry.path().extension(), ".partial") << entry.path();
+  }
+  EXPECT_EQ(files, 3);
+  // 10000 steps, a row every 10: 1001 rows and the header.
+  std::ifstream trajectory(work / "out" / "trajectory.csv");
+  int lines = 0;
+  for (std::string line; std::getline(trajectory, line);) ++lines;
+  EXPECT_EQ(lines, 1002);
+
+  // A refused scene writes nothing.
+  std::string bad(drop);
+  bad.replace(bad.find("0.0105"), 6, "0.005");
+  std::ofstream(work / "bad.toml") << bad;
+  EXPECT_EQ(millsim_in(work, "run bad.toml -q --out refused"), 2);
+  EXPECT_FALSE(fs::exists(work / "refused"));
+  std::error_code ignored;
+  fs::remove_all(work, ignored);
+}
+
+}  // namespace

@@ -1,0 +1,148 @@
+// The pure parts of `millsim sweep`: reading --vary, writing values without float noise, the
+// order of the points, their directory names, and the sweep.csv text.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "millsim/core/error.hpp"
+#include "millsim/sim/sweep.hpp"
+
+namespace millsim {
+namespace {
+
+using Values = std::vector<std::string>;
+
+/// The message of the InputError that parse_vary(argument) throws ("" if none).
+std::string refusal(const std::string& argument) {
+  try {
+    parse_vary(argument);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return {};
+}
+
+TEST(Sweep, ARangeRunsFromStartToStopInclusive) {
+  const SweepAxis axis = parse_vary("mill.speed=0.3:0.9:0.1");
+  EXPECT_EQ(axis.key, "mill.speed");
+  // 0.3 + 6 × 0.1 is 0.9000000000000001 and (0.9 − 0.3) / 0.1 is 5.999999999999999: the stop
+  // is included within the rounding tolerance and each value is printed as typed.
+  EXPECT_EQ(axis.values, (Values{"0.3", "0.4", "0.5", "0.6", "0.7", "0.8", "0.9"}));
+}
+
+TEST(Sweep, ARangeStopsAtTheLastWholeStepBeforeStop) {
+  EXPECT_EQ(parse_vary("mill.speed=0.3:0.95:0.2").values, (Values{"0.3", "0.5", "0.7", "0.9"}));
+  EXPECT_EQ(parse_vary("mill.lifters.count=4:16:4").values, (Values{"4", "8", "12", "16"}));
+  EXPECT_EQ(parse_vary("mill.speed=0.5:0.5:0.1").values, (Values{"0.5"}));
+}
+
+TEST(Sweep, ARangeMayCountDownAndUseExponents) {
+  EXPECT_EQ(parse_vary("mill.speed=0.9:0.6:-0.1").values, (Values{"0.9", "0.8", "0.7", "0.6"}));
+  EXPECT_EQ(parse_vary("simulation.time_step=1e-5:3e-5:1e-5").values,
+            (Values{"1e-05", "2e-05", "3e-05"}));
+}
+
+TEST(Sweep, AListKeepsItsValuesAsWritten) {
+  const SweepAxis axis = parse_vary(" charge.filling = 0.2, 0.30 ,0.4");
+  EXPECT_EQ(axis.key, "charge.filling");
+  EXPECT_EQ(axis.values, (Values{"0.2", "0.30", "0.4"}));
+  EXPECT_EQ(parse_vary("simulation.time_step=\"auto\",1e-5").values, (Values{"\"auto\"", "1e-5"}));
+  EXPECT_EQ(parse_vary("mill.speed=0.5").values, (Values{"0.5"}));
+}
+
+TEST(Sweep, RefusesABadSpecNamingTheArgumentAndWhatIsAllowed) {
+  const std::string allowed = "allowed: KEY=START:STOP:STEP";
+  for (const std::string argument :
+       {"mill.speed", "mill.speed=0.3:0.9", "mill.speed=0.3:0.9:0.1:2", "mill.speed=a:0.9:0.1",
+        "mill.speed=0.3:0.9:0", "mill.speed=0.9:0.3:0.1", "mill.speed=0.3,,0.5",
+        "mill.speed=", "mill.speed=0.3:inf:0.1"}) {
+    const std::string message = refusal(argument);
+    EXPECT_NE(message.find("command line (--vary " + argument + ")"), std::string::npos) << message;
+    EXPECT_NE(message.find(allowed), std::string::npos) << message;
+  }
+  EXPECT_NE(refusal("mill.speed=0.3:0.9:0").find("STEP is 0"), std::string::npos);
+  EXPECT_NE(refusal("mill.speed=0.9:0.3:0.1").find("leads away from STOP"), std::string::npos);
+  EXPECT_NE(refusal("mill.speed=a:0.9:0.1").find("START \"a\" is not a number"), std::string::npos);
+}
+
+TEST(Sweep, RefusesABadKeyTooManyPointsAndOutputDirectory) {
+  EXPECT_NE(refusal("mill..speed=0.3").find("is not a key"), std::string::npos);
+  EXPECT_NE(refusal("=0.3").find("is not a key"), std::string::npos);
+  EXPECT_NE(refusal("mill speed=0.3").find("is not a key"), std::string::npos);
+  EXPECT_NE(refusal("output.directory=a,b").find("--out"), std::string::npos);
+  EXPECT_NE(refusal("mill.speed=0:1:1e-6").find("at most 10000 values"), std::string::npos);
+  EXPECT_THROW(check_sweep_axes({{"mill.speed", {"0.5"}}, {"mill.speed", {"0.6"}}}), InputError);
+  const SweepAxis hundred = parse_vary("mill.speed=1:100:1");
+  EXPECT_NO_THROW(check_sweep_axes({hundred, {"charge.filling", Values(100, "0.3")}}));
+  EXPECT_THROW(check_sweep_axes({hundred, {"charge.filling", Values(101, "0.3")}}), InputError);
+}
+
+TEST(Sweep, NumbersAreWrittenWithoutFloatNoise) {
+  EXPECT_EQ(decimal_places("0.25"), 2);
+  EXPECT_EQ(decimal_places("3"), 0);
+  EXPECT_EQ(decimal_places("2.5e-4"), 5);
+  EXPECT_EQ(decimal_places("1e3"), 0);
+  EXPECT_EQ(decimal_places("-0.125E+1"), 2);
+  EXPECT_EQ(decimal_text(0.3 + 4 * 0.1, 1), "0.7");
+  EXPECT_EQ(decimal_text(0.1 + 0.2, 2), "0.3");
+  EXPECT_EQ(decimal_text(2.0, 1), "2");
+  EXPECT_EQ(decimal_text(-1e-17, 1), "0");
+  EXPECT_EQ(decimal_text(0.125, 3), "0.125");
+}
+
+TEST(Sweep, TheFirstAxisVariesSlowest) {
+  const std::vector<SweepAxis> axes{{"a", {"1", "2"}}, {"b", {"x", "y", "z"}}};
+  const std::vector<Values> points = cartesian_product(axes);
+  EXPECT_EQ(points, (std::vector<Values>{
+                        {"1", "x"}, {"1", "y"}, {"1", "z"}, {"2", "x"}, {"2", "y"}, {"2", "z"}}));
+  EXPECT_EQ(point_overrides(axes, points[4]), (Values{"a=2", "b=y"}));
+  EXPECT_EQ(cartesian_product({}), (std::vector<Values>{{}}));
+}
+
+TEST(Sweep, DirectoryNamesAreIndexedReadableAndFilesystemSafe) {
+  const std::vector<SweepAxis> axes{{"mill.speed", {}}, {"simulation.time_step", {}}};
+  EXPECT_EQ(point_directory_name(7, 20, axes, {"0.7", "1e-5"}),
+            "007_mill.speed=0.7_simulation.time_step=1e-5");
+  EXPECT_EQ(point_directory_name(3, 20, axes, {"0.7", "\"a/b c\""}),
+            "003_mill.speed=0.7_simulation.time_step=_a_b_c_");
+  EXPECT_EQ(point_directory_name(42, 1500, axes, {"1", "2"}),
+            "0042_mill.speed=1_simulation.time_step=2");
+}
+
+TEST(Sweep, CsvHasOneRowPerPointAndEveryScalar) {
+  const std::vector<SweepAxis> axes{{"mill.speed", {"0.5", "0.7"}}};
+  const std::vector<SweepRow> rows{
+      {{"0.5"}, "ok", {{"power_kw", 0.25}, {"empirical.bond_kw", 1.5}}},
+      {{"0.7"}, "failed: could not place 3 discs, \"try\" less", {}},
+  };
+  EXPECT_EQ(sweep_csv(axes, rows),
+            "point,mill.speed,status,power_kw,empirical.bond_kw\n"
+            "0,0.5,ok,0.25,1.5\n"
+            "1,0.7,\"failed: could not place 3 discs, \"\"try\"\" less\",,\n");
+}
+
+TEST(Sweep, CsvColumnsAreTheUnionOfTheRowsScalars) {
+  const std::vector<SweepAxis> axes{{"k", {"1", "2"}}};
+  const std::vector<SweepRow> rows{{{"1"}, "ok", {{"a", 1.0}}},
+                                   {{"2"}, "ok", {{"a", 2.0}, {"b", 0.1}}}};
+  EXPECT_EQ(sweep_csv(axes, rows), "point,k,status,a,b\n0,1,ok,1,\n1,2,ok,2,0.1\n");
+}
+
+TEST(Sweep, TableShowsPowersAndStatus) {
+  const std::vector<SweepAxis> axes{{"mill.speed", {"0.5", "0.7"}}};
+  const std::vector<SweepRow> rows{
+      {{"0.5"},
+       "ok",
+       {{"power_kw", 0.25}, {"power_dissipation_kw", 0.26}, {"energy_balance_error", 0.001}}},
+      {{"0.7"}, "failed: boom", {}},
+  };
+  const std::string table = sweep_table(axes, rows);
+  for (const char* part : {"mill.speed", "power_kw", "power_dissipation_kw", "energy_balance_error",
+                           "status", "0.25", "0.26", "0.001", "ok\n", "failed: boom\n"}) {
+    EXPECT_NE(table.find(part), std::string::npos) << part << " not in\n" << table;
+  }
+}
+
+}  // namespace
+}  // namespace millsim
