@@ -30,7 +30,9 @@ struct ContactInput {
   /// grows by the sliding displacement they make, so that it is the exact integral of it.
   Vec<D> step_velocity{};
   Vec<D> step_spin_velocity{};
-  double effective_mass = 0.0;  ///< m* = m_A m_B / (m_A + m_B); m of the particle for a wall
+  /// m* = m_A m_B / (m_A + m_B); m of the particle for a wall. Read only by the evaluate()
+  /// that works out the dashpot coefficients itself; World passes them precomputed.
+  double effective_mass = 0.0;
 };
 
 /// What a law returns: the force on B (A gets the opposite), its tangential part (the one that

@@ -9,6 +9,13 @@
 
 namespace millsim {
 
+/// The dashpot coefficients of one contact, c = 2 ζ sqrt(k m*). They depend on the effective
+/// mass alone, so a pair's are worked out once per neighbour-list rebuild, not once a step.
+struct ContactDamping {
+  double normal = 0.0;      ///< c_n, N s/m
+  double tangential = 0.0;  ///< c_s, N s/m
+};
+
 /// Stateless: its members are parameters, all state lives in the ContactHistory it is given.
 /// Particle–particle and particle–wall contacts use this same law; only the inputs differ.
 class LinearSpringDashpot {
@@ -37,9 +44,25 @@ class LinearSpringDashpot {
            norm_squared(history.tangential_spring) / (2.0 * tangential_stiffness_);
   }
 
+  /// c_n = 2 ζ sqrt(k_n) sqrt(m*) and c_s = 2 ζ sqrt(k_s) sqrt(m*) for effective mass m*.
+  ContactDamping damping(double effective_mass) const {
+    const double sqrt_mass = std::sqrt(effective_mass);
+    return {2.0 * damping_ratio_ * sqrt_normal_stiffness_ * sqrt_mass,
+            2.0 * damping_ratio_ * sqrt_tangential_stiffness_ * sqrt_mass};
+  }
+
   template <int D>
   ContactOutput<D> evaluate(const ContactInput<D>& in, ContactHistory<D>& history,
                             double time_step) const {
+    return evaluate(in, damping(in.effective_mass), history, time_step);
+  }
+
+  /// The same with the dashpot coefficients given (from damping(in.effective_mass)).
+  /// Always inlined: the pair and wall loops call it once per contact and step, and the
+  /// inputs and outputs then stay in registers.
+  template <int D>
+  ContactOutput<D> evaluate(const ContactInput<D>& in, const ContactDamping& damping,
+                            ContactHistory<D>& history, double time_step) const {
     const Vec<D>& n = in.normal;
     const double normal_speed = dot(in.velocity, n);  // v·n < 0 while the pair approaches
     const Vec<D> sliding_velocity = in.velocity - normal_speed * n + in.spin_velocity;  // v_s
@@ -47,8 +70,7 @@ class LinearSpringDashpot {
         in.step_velocity - dot(in.step_velocity, n) * n + in.step_spin_velocity;
 
     // Normal: spring k_n (δ − origin) and dashpot D_n = −c_n v_n, c_n = 2 ζ sqrt(k_n m*).
-    const double sqrt_mass = std::sqrt(in.effective_mass);
-    const double normal_damping = 2.0 * damping_ratio_ * sqrt_normal_stiffness_ * sqrt_mass;
+    const double normal_damping = damping.normal;
     const double normal_spring = normal_stiffness_ * (in.overlap - history.normal_spring_origin);
     const double normal_force = normal_spring - normal_damping * normal_speed;
 
@@ -85,7 +107,7 @@ class LinearSpringDashpot {
     const Vec<D> step_slip = time_step * step_sliding_velocity;  // Δs, B relative to A
     spring -= tangential_stiffness_ * step_slip;
     const double friction_limit = friction_ * std::abs(normal_force);
-    const double tangential_damping = 2.0 * damping_ratio_ * sqrt_tangential_stiffness_ * sqrt_mass;
+    const double tangential_damping = damping.tangential;
     const Vec<D> trial = spring - tangential_damping * sliding_velocity;
     const double trial_length = norm(trial);
     if (trial_length > friction_limit) {

@@ -5,6 +5,14 @@
 #include <cmath>
 
 namespace millsim {
+namespace {
+
+/// Particles searched by one thread at a time in a rebuild, and the fewest particles for which
+/// the search is worth running on several threads.
+constexpr std::size_t search_chunk = 512;
+constexpr std::size_t parallel_search_threshold = 2048;
+
+}  // namespace
 
 template <int D>
 bool NeighbourList<D>::needs_refresh(const std::vector<Vec<D>>& position) const {
@@ -78,17 +86,25 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       ++cell_start_[index + 1];
     }
     for (std::size_t c = 0; c < total; ++c) cell_start_[c + 1] += cell_start_[c];
+    // Each cell's members with their positions and radii copied alongside, so that the search
+    // below reads them in sequence instead of gathering them from the particle arrays.
     cell_members_.resize(count);
+    cell_position_.resize(count);
+    cell_radius_.resize(count);
     cell_cursor_.assign(cell_start_.begin(), cell_start_.end() - 1);
     for (std::size_t i = 0; i < count; ++i) {
-      cell_members_[cell_cursor_[particle_cell_[i]]++] = static_cast<std::uint32_t>(i);
+      const std::uint32_t slot = cell_cursor_[particle_cell_[i]]++;
+      cell_members_[slot] = static_cast<std::uint32_t>(i);
+      cell_position_[slot] = position[i];
+      cell_radius_[slot] = radius[i];
     }
 
-    found_.clear();
-    // Particles in cell order, so that neighbouring searches touch neighbouring memory.
-    for (const std::uint32_t member : cell_members_) {
-      const std::size_t i = member;
-      const double cutoff = 2.0 * radius[i] + skin_;  // the farthest a smaller partner can be
+    // Pairs found from particle i (see above) go to `found`.
+    const auto search_from = [&](std::size_t i,
+                                 std::vector<std::pair<std::uint32_t, std::uint32_t>>& found) {
+      const double own_radius = radius[i];
+      const Vec<D> own_position = position[i];
+      const double cutoff = 2.0 * own_radius + skin_;  // the farthest a smaller partner can be
       std::array<long, D> from{};
       std::array<long, D> to{};
       for (int a = 0; a < D; ++a) {
@@ -109,12 +125,14 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
         const std::uint32_t begin = cell_start_[row + static_cast<std::size_t>(from[0])];
         const std::uint32_t end = cell_start_[row + static_cast<std::size_t>(to[0]) + 1];
         for (std::uint32_t k = begin; k < end; ++k) {
+          const double other_radius = cell_radius_[k];
+          if (other_radius > own_radius) continue;
           const std::uint32_t j = cell_members_[k];
-          if (radius[j] > radius[i] || (radius[j] == radius[i] && j <= i)) continue;
-          const double reach = radius[i] + radius[j] + skin_;
-          if (norm_squared(separation(position[i], position[j])) < reach * reach) {
+          if (other_radius == own_radius && j <= i) continue;
+          const double reach = own_radius + other_radius + skin_;
+          if (norm_squared(separation(own_position, cell_position_[k])) < reach * reach) {
             const auto self = static_cast<std::uint32_t>(i);
-            found_.push_back(self < j ? std::pair{self, j} : std::pair{j, self});
+            found.push_back(self < j ? std::pair{self, j} : std::pair{j, self});
           }
         }
       };
@@ -133,17 +151,37 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
           }
         }
       }
+    };
+    // Particles in cell order, so that neighbouring searches touch neighbouring memory, in
+    // chunks of a fixed size that threads search apart, each into its own list. The sorts
+    // below give the same pair list whatever the chunks and threads.
+    const std::size_t chunks = (count + search_chunk - 1) / search_chunk;
+    if (found_.size() < chunks) found_.resize(chunks);
+#pragma omp parallel for schedule(dynamic) if (count >= parallel_search_threshold)
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+      std::vector<std::pair<std::uint32_t, std::uint32_t>>& found = found_[chunk];
+      found.clear();
+      const std::size_t chunk_end = std::min(count, (chunk + 1) * search_chunk);
+      for (std::size_t member = chunk * search_chunk; member < chunk_end; ++member) {
+        search_from(cell_members_[member], found);
+      }
     }
     // Sorted by (first, second): a counting sort by first, then each first's seconds.
     pair_cursor_.assign(count + 1, 0);
-    for (const auto& pair : found_) ++pair_cursor_[pair.first + 1];
+    std::size_t found_count = 0;
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+      for (const auto& pair : found_[chunk]) ++pair_cursor_[pair.first + 1];
+      found_count += found_[chunk].size();
+    }
     for (std::size_t i = 0; i < count; ++i) pair_cursor_[i + 1] += pair_cursor_[i];
-    next_first_.resize(found_.size());
-    next_second_.resize(found_.size());
-    for (const auto& [a, b] : found_) {
-      const std::uint32_t slot = pair_cursor_[a]++;
-      next_first_[slot] = a;
-      next_second_[slot] = b;
+    next_first_.resize(found_count);
+    next_second_.resize(found_count);
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+      for (const auto& [a, b] : found_[chunk]) {
+        const std::uint32_t slot = pair_cursor_[a]++;
+        next_first_[slot] = a;
+        next_second_[slot] = b;
+      }
     }
     std::uint32_t begin = 0;
     for (std::size_t i = 0; i < count; ++i) {

@@ -64,9 +64,11 @@ class NeighbourList {
   std::vector<Vec<D>> reference_position_;
   // Scratch kept between rebuilds so that a rebuild allocates nothing in steady state.
   std::vector<std::uint32_t> particle_cell_, cell_start_, cell_cursor_, cell_members_;
+  std::vector<Vec<D>> cell_position_;
+  std::vector<double> cell_radius_;
   std::vector<std::uint32_t> next_first_, next_second_;
   std::vector<std::array<long, D>> particle_home_;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> found_;
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found_;  // per search chunk
   std::vector<std::uint32_t> pair_cursor_;
   std::vector<ContactHistory<D>> next_history_;
 };

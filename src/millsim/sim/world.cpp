@@ -86,9 +86,21 @@ void World<D>::refresh_neighbours() {
     neighbours_.set_period(axial_period());
   }
   neighbours_.rebuild(particles_.position, particles_.radius);
+  // Pair forces start at zero and return to zero when a contact ends, so that a pair that is
+  // not touching costs no store (evaluate_pair_contacts).
   const std::size_t pairs = neighbours_.pair_count();
-  pair_force_.resize(pairs);
-  pair_moment_.resize(pairs);
+  pair_force_.assign(pairs, PairForce{});
+  pair_damping_.resize(pairs);
+  const auto& first = neighbours_.first();
+  const auto& second = neighbours_.second();
+  const auto& m = particles_.mass;
+  for (std::size_t p = 0; p < pairs; ++p) {
+    const std::uint32_t i = first[p];
+    const std::uint32_t j = second[p];
+    pair_damping_[p] = ball_ball_law_.damping(m[i] * m[j] / (m[i] + m[j]));
+  }
+  wall_damping_.resize(count);
+  for (std::size_t i = 0; i < count; ++i) wall_damping_[i] = ball_wall_law_.damping(m[i]);
   pair_ended_.resize(pairs);
   pair_block_ended_.resize(block_count(pairs, pair_block));
   pair_block_dissipated_.resize(block_count(pairs, pair_block));
@@ -160,7 +172,6 @@ void World<D>::evaluate_pair_contacts() {
   const auto& step_v = particles_.velocity;
   const auto& step_w = particles_.angular_velocity;
   const auto& r = particles_.radius;
-  const auto& m = particles_.mass;
   const double dt = settings_.time_step;
   const std::size_t pairs = first.size();
   const std::size_t blocks = pair_block_ended_.size();
@@ -179,9 +190,8 @@ void World<D>::evaluate_pair_contacts() {
         if (history[p].touching) {
           pair_ended_[b * pair_block + ended++] = {ContactType::ball_ball, history[p].dissipated};
           history[p] = ContactHistory<D>{};
+          pair_force_[p] = PairForce{};
         }
-        pair_force_[p] = Vec<D>{};
-        pair_moment_[p] = Spin<D>{};
         continue;
       }
       const double distance = std::sqrt(distance_squared);
@@ -192,12 +202,10 @@ void World<D>::evaluate_pair_contacts() {
       in.spin_velocity = cross(in.normal, r[i] * w[i] + r[j] * w[j]);
       in.step_velocity = step_v[j] - step_v[i];
       in.step_spin_velocity = cross(in.normal, r[i] * step_w[i] + r[j] * step_w[j]);
-      in.effective_mass = m[i] * m[j] / (m[i] + m[j]);
       history[p].touching = true;
       history[p].overlap = in.overlap;
-      const ContactOutput<D> out = ball_ball_law_.evaluate(in, history[p], dt);
-      pair_force_[p] = out.force;
-      pair_moment_[p] = -cross(in.normal, out.tangential_force);
+      const ContactOutput<D> out = ball_ball_law_.evaluate(in, pair_damping_[p], history[p], dt);
+      pair_force_[p] = {out.force, -cross(in.normal, out.tangential_force)};
       dissipated += out.dissipated;
     }
     pair_block_dissipated_[b] = dissipated;
@@ -246,11 +254,10 @@ void World<D>::evaluate_wall_contacts() {
         in.spin_velocity = cross(contact.normal, radius * spin_now_[i]);
         in.step_velocity = particles_.velocity[i] - contact.wall_velocity;
         in.step_spin_velocity = cross(contact.normal, radius * particles_.angular_velocity[i]);
-        in.effective_mass = particles_.mass[i];
         ContactHistory<D>& history = slot_history[slot];
         history.touching = true;
         history.overlap = contact.overlap;
-        const ContactOutput<D> out = ball_wall_law_.evaluate(in, history, dt);
+        const ContactOutput<D> out = ball_wall_law_.evaluate(in, wall_damping_[i], history, dt);
         force += out.force;
         moment += -radius * cross(contact.normal, out.tangential_force);
         dissipated += out.dissipated;
@@ -303,13 +310,13 @@ void World<D>::accumulate_forces() {
     Vec<D> f = wall_force_[i];
     Spin<D> moment = wall_moment_[i];
     for (std::uint32_t p = first_begin[i]; p < first_begin[i + 1]; ++p) {
-      f -= pair_force_[p];
-      moment += r[i] * pair_moment_[p];
+      f -= pair_force_[p].force;
+      moment += r[i] * pair_force_[p].moment;
     }
     for (std::uint32_t k = second_begin[i]; k < second_begin[i + 1]; ++k) {
       const std::uint32_t p = second_pairs[k];
-      f += pair_force_[p];
-      moment += r[i] * pair_moment_[p];
+      f += pair_force_[p].force;
+      moment += r[i] * pair_force_[p].moment;
     }
     force[i] = f + m[i] * gravity;
     torque[i] = moment;

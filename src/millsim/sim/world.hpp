@@ -106,9 +106,14 @@ class World {
   // Work is split in blocks of a fixed size; each block keeps its own sums and ended
   // collisions, added up in block order, so results do not depend on the number of threads.
   // Per pair of the neighbour list: force on the second particle and the moment per unit
-  // radius, −n × F_t, that both particles receive (scaled by their radii).
-  std::vector<Vec<D>> pair_force_;
-  std::vector<Spin<D>> pair_moment_;
+  // radius, −n × F_t, that both particles receive (scaled by their radii), side by side for
+  // the gather; and the pair's dashpot coefficients, set at each rebuild.
+  struct PairForce {
+    Vec<D> force{};
+    Spin<D> moment{};
+  };
+  std::vector<PairForce> pair_force_;
+  std::vector<ContactDamping> pair_damping_;
   std::vector<EndedCollision> pair_ended_;  // block b's at [b × pair_block, ...)
   std::vector<std::uint32_t> pair_block_ended_;
   std::vector<double> pair_block_dissipated_;
@@ -118,6 +123,7 @@ class World {
   std::vector<std::uint32_t> wall_candidates_;
   std::vector<Vec<D>> wall_force_;
   std::vector<Spin<D>> wall_moment_;
+  std::vector<ContactDamping> wall_damping_;  // per particle, set at each rebuild
   // Per particle, max_wall_contacts slots of wall-contact history keyed by wall id.
   std::vector<std::int32_t> wall_slot_id_;
   std::vector<ContactHistory<D>> wall_slot_history_;
