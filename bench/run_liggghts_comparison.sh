@@ -1,0 +1,154 @@
+#!/usr/bin/env bash
+# Issue 5, target 2: millsim against LIGGGHTS (Debian package `liggghts`) on the same 3D mill
+# (bench/mill-3d-20k.toml: 0.9 m x 0.73 m, eight 4 x 4 cm lifters, flat end plates, 19 956
+# balls of 20 mm, 30 % filling, 75 % of critical, dt 1e-5 s, the same k_n, k_s, e, mu).
+#
+#   bench/run_liggghts_comparison.sh [STEPS]                 speed (about 10 min, idle machine)
+#   bench/run_liggghts_comparison.sh --power [LIFT [WINDOW]]   power drawn (about 10 min)
+#
+# Both: install LIGGGHTS with apt-get if `liggghts` is missing (needs root), build millsim,
+# settle the charge once with millsim (simulation.settle_time = 0.4 s, shell still) and save
+# the state (kept in the work directory and reused while the settle command is the same); the
+# LIGGGHTS runs start from that state. bench/liggghts/make_input.py writes the LIGGGHTS input:
+# STL shell + lifters + end plates turned by `fix move/mesh rotate`, the balls, and
+# `hooke/stiffness` + `tangential history` with the same stiffnesses and friction and
+# millsim's Corkum damping converted to LIGGGHTS' gamman/gammat (see that file).
+#
+# Speed: the shell turns at full speed for 1000 untimed steps, then STEPS (default 5000) steps
+# are timed: millsim on 1 thread, LIGGGHTS on 1 MPI rank, millsim on 2 threads, LIGGGHTS on 2
+# ranks, back to back. Prints particle-steps/s (LIGGGHTS: atoms x steps / loop time of the
+# timed `run`) and the ratio millsim/LIGGGHTS.
+#
+# Power (not timed, so the two codes run at the same time, each on one core; millsim's result
+# does not depend on its thread count): from the settled state the shell turns at full speed at
+# once, LIFT steps (default 30000, 0.3 s) lift the charge, then the drive power is averaged
+# over WINDOW steps (default 20000, 0.2 s). millsim: bench/liggghts/millsim_power_window.cpp
+# (built here with g++ against the millsim build), the shell's work per second as in millsim's
+# power_kw; LIGGGHTS: minus the torque about the axis of the balls on the mesh
+# (`fix mesh/surface/stress`) times omega.
+#
+# Environment: MILLSIM_BUILD (a build directory to use as it is; default build/release, built
+# with the release preset), MILLSIM_SOURCE (the source tree of that build, default this one),
+# LIGGGHTS_WORK (work directory, default runs/liggghts-comparison), SETTLE_TIME (s, default 0.4).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+steps=5000
+mode=speed
+lift=30000
+window=20000
+numbers=()
+for arg in "$@"; do
+  case "$arg" in
+    --power) mode=power ;;
+    ''|*[!0-9]*) echo "usage: $0 [STEPS] | $0 --power [LIFT [WINDOW]]" >&2; exit 2 ;;
+    *) numbers+=("$arg") ;;
+  esac
+done
+if [ "$mode" = speed ]; then
+  steps=${numbers[0]:-$steps}
+else
+  lift=${numbers[0]:-$lift}
+  window=${numbers[1]:-$window}
+fi
+warmup=1000
+settle=${SETTLE_TIME:-0.4}
+config=bench/mill-3d-20k.toml
+work=${LIGGGHTS_WORK:-runs/liggghts-comparison}
+build=${MILLSIM_BUILD:-build/release}
+
+echo "== machine: $(nproc) cores; load average $(cut -d' ' -f1-3 /proc/loadavg) (1, 5, 15 min)"
+
+# --- LIGGGHTS from Debian -------------------------------------------------------------------
+if ! command -v liggghts >/dev/null; then
+  if [ "$(id -u)" != 0 ]; then echo "liggghts is missing; run as root to install it" >&2; exit 1; fi
+  apt-cache search liggghts
+  DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends liggghts \
+    || { apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends liggghts; }
+fi
+echo "== $(dpkg-query -W -f '${Package} ${Version}' liggghts 2>/dev/null || echo liggghts)"
+
+# --- millsim -----------------------------------------------------------------------------------
+if [ -z "${MILLSIM_BUILD:-}" ]; then
+  bash scripts/install-deps.sh >/dev/null
+  cmake --preset release >/dev/null
+  cmake --build --preset release --target millsim millsim_scene_bench >/dev/null
+fi  # a given MILLSIM_BUILD is used as it is (not rebuilt)
+bench="$build/bench/millsim_scene_bench"
+millsim="$build/millsim"
+src=${MILLSIM_SOURCE:-.}
+echo "== millsim: $build (source $src: $(git -C "$src" rev-parse --short HEAD 2>/dev/null || echo 'not a git tree')$(git -C "$src" diff --quiet 2>/dev/null || echo ', with uncommitted changes'))"
+
+mkdir -p "$work"
+work=$(cd "$work" && pwd)
+state="$work/settled.state"
+
+settle_cmd=("$bench" "$config" --set simulation.settle_time=$settle --warmup 0 --steps 1 -j 1
+            --save-state "$state")
+if [ -f "$state" ] && [ "$(cat "$work/settled.cmd" 2>/dev/null)" = "${settle_cmd[*]:1}" ]; then
+  echo "== settled state: reusing $state"
+else
+  echo "== settling with millsim (settle_time $settle s, 1 thread: the same state for any count)"
+  rm -f "$work/settled.cmd"
+  "${settle_cmd[@]}" | grep -E '^(particles|prepared)'
+  echo "${settle_cmd[*]:1}" > "$work/settled.cmd"
+fi
+
+rate_of_millsim() { awk '/^particle-steps\/s/ {print $2}' "$1"; }
+# LIGGGHTS: natoms x steps / loop time of the last `run` (the timed one).
+rate_of_liggghts() {
+  awk '/^Loop time of/ {t = $4; n = $9; a = $12} END {printf "%.4g\n", a * n / t}' "$1"
+}
+
+if [ "$mode" = speed ]; then
+  python3 bench/liggghts/make_input.py "$config" "$state" "$work/timing" \
+    --mode timing --warmup $warmup --steps "$steps"
+  declare -A ms lg
+  for n in 1 2; do
+    echo "== millsim, $n thread(s): $warmup warmup + $steps timed steps"
+    "$bench" "$config" --load-state "$state" --warmup $warmup --steps "$steps" -j $n \
+      | tee "$work/millsim-$n.txt" | grep -E '^(timed|particle-steps)'
+    ms[$n]=$(rate_of_millsim "$work/millsim-$n.txt")
+    echo "== LIGGGHTS, $n MPI rank(s): $warmup warmup + $steps timed steps"
+    (cd "$work/timing" && mpirun --allow-run-as-root --bind-to none -np $n liggghts \
+      -in in.mill -log "log.np$n" > "screen.np$n")
+    grep '^Loop time of' "$work/timing/log.np$n" | tail -1
+    lg[$n]=$(rate_of_liggghts "$work/timing/log.np$n")
+  done
+  echo
+  echo "== particle-steps per second ($steps timed steps after $warmup at full speed;" \
+    "load average now $(cut -d' ' -f1-3 /proc/loadavg))"
+  printf '%-7s %14s %14s %18s\n' cores millsim LIGGGHTS millsim/LIGGGHTS
+  for n in 1 2; do
+    printf '%-7s %14s %14s %18s\n' "$n" "${ms[$n]}" "${lg[$n]}" \
+      "$(awk -v a="${ms[$n]}" -v b="${lg[$n]}" 'BEGIN {printf "%.2f", a / b}')"
+  done
+  exit 0
+fi
+
+# --- power -------------------------------------------------------------------------------------
+source_dir=${MILLSIM_SOURCE:-.}
+driver="$work/millsim_power_window"
+g++ -std=c++20 -O3 -DNDEBUG -fno-math-errno -fopenmp -DFMT_SHARED -DTOML_HEADER_ONLY=0 \
+  -DTOML_SHARED_LIB=1 -I"$source_dir/src" -I"$build/generated" \
+  bench/liggghts/millsim_power_window.cpp "$build/libmillsim_core.a" -ltomlplusplus -lfmt \
+  -o "$driver"
+echo "== power: $lift steps at full speed from the settled state, then $window steps averaged;" \
+  "millsim (1 thread) and LIGGGHTS (1 rank) at the same time"
+"$driver" "$config" "$state" "$lift" "$window" 1 > "$work/millsim-power.txt" &
+millsim_pid=$!
+python3 bench/liggghts/make_input.py "$config" "$state" "$work/power" --mode power \
+  --lift "$lift" --window "$window"
+(cd "$work/power" && mpirun --allow-run-as-root --bind-to none -np 1 liggghts \
+  -in in.mill -log log.power > screen.power)
+wait "$millsim_pid"
+cat "$work/millsim-power.txt"
+omega=$(awk '/rad\/s, dt =/ {for (i = 1; i <= NF; i++) if ($i == "rad/s,") print $(i - 1)}' \
+  "$work/power/in.mill")
+# torque.txt: step, mean torque of the balls on the mesh about +z over 100 steps.
+liggghts_torque=$(awk '!/^#/ {s += $2; n++} END {printf "%.5f", s / n}' "$work/power/torque.txt")
+echo "LIGGGHTS: torque of the balls on the mesh $liggghts_torque N m (omega $omega rad/s)"
+echo
+echo "== drive power, kW, mean over $window steps after $lift at full speed"
+echo "millsim   $(awk '/^power_kw/ {print $2}' "$work/millsim-power.txt")"
+echo "LIGGGHTS  $(awk -v t="$liggghts_torque" -v w="$omega" 'BEGIN {printf "%.5f", -t * w / 1000}')"
