@@ -15,7 +15,14 @@
 #include <string>
 #include <vector>
 
+#include "support/program_test.hpp"
+
 namespace {
+
+using millsim::testing::Outcome;
+using millsim::testing::ProgramTest;
+using millsim::testing::quoted;
+using millsim::testing::read_all;
 
 namespace fs = std::filesystem;
 
@@ -26,17 +33,6 @@ const std::string small_mill =
 constexpr const char* tiny_run =
     " --set simulation.revolutions=1 --set simulation.measure_revolutions=1"
     " --set simulation.settle_time=0.01 --set mill.speed=1.5";
-
-std::string quoted(const std::string& text) {
-  std::string out = "'";
-  for (const char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string read_all(const fs::path& path) {
-  std::ifstream file(path);
-  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
-}
 
 /// The fields of one CSV line (RFC 4180 quoting).
 std::vector<std::string> csv_fields(const std::string& line) {
@@ -76,42 +72,7 @@ std::vector<std::map<std::string, std::string>> read_csv(const fs::path& path) {
   return rows;
 }
 
-struct Outcome {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
-
-class SweepPowerCurve : public ::testing::Test {
- protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "millsim-sweep-XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    root_ = pattern;
-    work_ = root_ / "work";
-    fs::create_directory(work_);
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(root_, ignored);
-  }
-
-  /// Runs `millsim ARGS` in the working directory; ARGS is shell text.
-  Outcome millsim(const std::string& args) const {
-    const std::string command = "cd " + quoted(work_.string()) + " && " + quoted(MILLSIM_BINARY) +
-                                " " + args + " >" + quoted((root_ / "stdout").string()) + " 2>" +
-                                quoted((root_ / "stderr").string()) + " </dev/null";
-    const int raw = std::system(command.c_str());
-    Outcome o;
-    o.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    o.out = read_all(root_ / "stdout");
-    o.err = read_all(root_ / "stderr");
-    return o;
-  }
-
-  fs::path root_;
-  fs::path work_;
-};
+class SweepPowerCurve : public ProgramTest {};
 
 TEST_F(SweepPowerCurve, PowerRisesToAPeakBelowCriticalAndFallsAsTheChargeCentrifuges) {
   const Outcome o =

@@ -16,7 +16,14 @@
 #include <string_view>
 #include <vector>
 
+#include "support/program_test.hpp"
+
 namespace {
+
+using millsim::testing::Outcome;
+using millsim::testing::ProgramTest;
+using millsim::testing::quoted;
+using millsim::testing::read_all;
 
 namespace fs = std::filesystem;
 
@@ -91,52 +98,10 @@ std::string at_line(std::string_view text, std::string_view start) {
   return "mill.toml:" + std::to_string(line_of(text, start));
 }
 
-std::string quoted(const std::string& text) {
-  std::string out = "'";
-  for (const char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string read_all(const fs::path& path) {
-  std::ifstream file(path);
-  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
-}
-
-struct Outcome {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
-
-class Cli : public ::testing::Test {
+class Cli : public ProgramTest {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "millsim-cli-XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    root_ = pattern;
-    work_ = root_ / "work";
-    fs::create_directory(work_);
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(root_, ignored);
-  }
-
   /// Writes the config `mill.toml` in the working directory.
   void write_config(std::string_view text) const { std::ofstream(work_ / "mill.toml") << text; }
-
-  /// Runs `millsim ARGS` in the working directory; ARGS is shell text.
-  Outcome millsim(const std::string& args) const {
-    const std::string command = "cd " + quoted(work_.string()) + " && " + quoted(MILLSIM_BINARY) +
-                                " " + args + " >" + quoted((root_ / "stdout").string()) + " 2>" +
-                                quoted((root_ / "stderr").string()) + " </dev/null";
-    const int raw = std::system(command.c_str());
-    Outcome o;
-    o.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    o.out = read_all(root_ / "stdout");
-    o.err = read_all(root_ / "stderr");
-    return o;
-  }
 
   /// Runs `millsim run mill.toml -o out -q EXTRA` on `text`.
   Outcome run_config(std::string_view text, const std::string& extra = {}) const {
@@ -159,9 +124,6 @@ class Cli : public ::testing::Test {
       EXPECT_EQ(entry.path().filename(), "mill.toml") << "written: " << entry.path();
     }
   }
-
-  fs::path root_;
-  fs::path work_;
 };
 
 TEST_F(Cli, ATinyRunOfTheBaseConfigWritesItsResults) {

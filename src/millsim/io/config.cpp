@@ -61,6 +61,19 @@ std::string belongs_elsewhere(std::string_view key) {
   return {};
 }
 
+/// simulation.time_step: "auto" (empty) or a number of seconds > 0.
+std::optional<double> read_time_step(TableReader& section) {
+  const std::string step_rule = "\"auto\" or a number of seconds > 0";
+  const toml::node* step = section.node("time_step");
+  if (step == nullptr) return std::nullopt;
+  if (!step->is_string()) return section.number("time_step", std::nullopt, step_rule, positive);
+  if (step->as_string()->get() != "auto") {
+    section.fail_at("time_step", fmt::format("{} is not allowed; allowed: {}",
+                                             describe_value(*step), step_rule));
+  }
+  return std::nullopt;
+}
+
 void read_simulation(TableReader section, MillConfig& config) {
   section.allow_keys(
       {"dimension", "time_step", "settle_time", "revolutions", "measure_revolutions", "seed"},
@@ -68,17 +81,7 @@ void read_simulation(TableReader section, MillConfig& config) {
   config.dimension =
       static_cast<int>(section.integer("dimension", 2, "2 (a slice of discs) or 3 (spheres)",
                                        [](long d) { return d == 2 || d == 3; }));
-  const std::string step_rule = "\"auto\" or a number of seconds > 0";
-  if (const toml::node* step = section.node("time_step")) {
-    if (step->is_string()) {
-      if (step->as_string()->get() != "auto") {
-        section.fail_at("time_step", fmt::format("{} is not allowed; allowed: {}",
-                                                 describe_value(*step), step_rule));
-      }
-    } else {
-      config.time_step = section.number("time_step", std::nullopt, step_rule, positive);
-    }
-  }
+  config.time_step = read_time_step(section);
   config.settle_time = section.number("settle_time", 1.0, "a number of seconds >= 0, at most 1e4",
                                       [](double t) { return t >= 0.0 && t <= 1e4; });
   // At least one revolution: measure_revolutions (a whole number >= 1) are measured of them.
@@ -411,17 +414,7 @@ void read_scene_simulation(TableReader section, SceneConfig& config) {
   section.allow_keys({"dimension", "time_step", "duration", "gravity"}, scene_hint);
   config.dimension = static_cast<int>(section.integer("dimension", 2, "2 (discs) or 3 (spheres)",
                                                       [](long d) { return d == 2 || d == 3; }));
-  const std::string step_rule = "\"auto\" or a number of seconds > 0";
-  if (const toml::node* step = section.node("time_step")) {
-    if (step->is_string()) {
-      if (step->as_string()->get() != "auto") {
-        section.fail_at("time_step", fmt::format("{} is not allowed; allowed: {}",
-                                                 describe_value(*step), step_rule));
-      }
-    } else {
-      config.time_step = section.number("time_step", std::nullopt, step_rule, positive);
-    }
-  }
+  config.time_step = read_time_step(section);
   config.duration = section.number("duration", std::nullopt, "a number of seconds > 0, at most 1e4",
                                    [](double t) { return t > 0.0 && t <= 1e4; });
   std::vector<double> down(static_cast<std::size_t>(config.dimension), 0.0);
