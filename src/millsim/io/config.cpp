@@ -286,14 +286,20 @@ ContactMaterial read_material(TableReader section) {
   return m;
 }
 
-void read_output(TableReader section, MillConfig& config) {
-  section.allow_keys({"directory", "snapshot_interval"}, belongs_elsewhere);
+/// output.directory: a non-empty path, default "out".
+std::string read_output_directory(TableReader& section) {
   const std::string directory_rule = "a directory path (a non-empty string)";
-  config.output_directory = section.string("directory", "out", directory_rule);
-  if (config.output_directory.empty()) {
+  std::string directory = section.string("directory", "out", directory_rule);
+  if (directory.empty()) {
     section.fail_at("directory",
                     fmt::format("an empty path is not allowed; allowed: {}", directory_rule));
   }
+  return directory;
+}
+
+void read_output(TableReader section, MillConfig& config) {
+  section.allow_keys({"directory", "snapshot_interval"}, belongs_elsewhere);
+  config.output_directory = read_output_directory(section);
   config.snapshot_interval =
       section.number("snapshot_interval", 0.05, "a number of seconds >= 0 (0 = no snapshots)",
                      [](double t) { return t >= 0.0; });
@@ -582,12 +588,7 @@ SceneConfig read_scene_config(const toml::table& document, const std::string& so
   config.ball_wall = read_material(materials.table("ball_wall", false));
   TableReader output = root.table("output", false);
   output.allow_keys({"directory", "trajectory_interval"}, scene_hint);
-  const std::string directory_rule = "a directory path (a non-empty string)";
-  config.output_directory = output.string("directory", "out", directory_rule);
-  if (config.output_directory.empty()) {
-    output.fail_at("directory",
-                   fmt::format("an empty path is not allowed; allowed: {}", directory_rule));
-  }
+  config.output_directory = read_output_directory(output);
   config.trajectory_interval =
       output.number("trajectory_interval", 0.0,
                     "a number of seconds >= 0 (0 = only the start and the end in trajectory.csv)",
