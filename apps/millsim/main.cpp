@@ -214,6 +214,13 @@ int info_command(const JobOptions& options) {
   } else if (c.periodic) {
     fmt::print("model                 3D periodic slab {} m long, power scaled to the {} m mill\n",
                c.slab_length, c.length);
+  } else if (c.cone_length > 0.0) {
+    fmt::print(
+        "model                 3D whole mill with conical ends: {} m long each at {} "
+        "degrees, trunnion radius {:.4g} m; {:.4g} m3 and a bed of {:.4g} m3 in each "
+        "cone\n",
+        c.cone_length, c.cone_angle_degrees, plan.trunnion_radius, plan.cone_volume,
+        plan.cone_bed_volume);
   } else {
     fmt::print("model                 3D whole mill with flat end plates\n");
   }

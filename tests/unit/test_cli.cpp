@@ -234,6 +234,23 @@ TEST_F(Cli, RefusesASlabTooShortForItsBalls) {
                                     "at least three largest ball diameters"});
 }
 
+TEST_F(Cli, InfoOfAConicalMillPrintsItsCones) {
+  // examples/conical-mill-3d.toml: 20°, 0.1 m cones on a 0.9 m mill, r_t = 0.45 − 0.1 / tan 20°.
+  const Outcome info =
+      millsim(std::string("info ") + MILLSIM_SOURCE_DIR + "/examples/conical-mill-3d.toml");
+  ASSERT_EQ(info.status, 0) << info.err;
+  EXPECT_NE(info.out.find("conical ends: 0.1 m long each at 20 degrees, trunnion radius 0.1753 m"),
+            std::string::npos)
+      << info.out;
+  EXPECT_NE(info.out.find("particles             385"), std::string::npos) << info.out;
+}
+
+TEST_F(Cli, RefusesConesOnA2DMill) {
+  const std::string text = with(base_config, "speed", "speed = 0.5\ncone_angle = 15");
+  expect_refused(run_config(text), {at_line(text, "cone_angle"), "mill.cone_angle",
+                                    "simulation.dimension = 3"});
+}
+
 TEST_F(Cli, RefusesANamedTimeStepOtherThanAuto) {
   const std::string text = with(base_config, "time_step", "time_step = \"fast\"");
   expect_refused(run_config(text), {at_line(text, "time_step"), "simulation.time_step",

@@ -122,6 +122,16 @@ bool beyond_lifter_reach(const Mill2D& mill, const Vec2& planar_centre, double p
          norm(planar_centre) + particle_radius <= mill.radius - mill.lifter_height;
 }
 
+/// With conical ends the shell is the cylinder 0 ≤ z ≤ length only. A centre beyond an end of
+/// it that touches the shell's surface is inside the cone (closest to the cone's face, never to
+/// the shell's edge: the shell–cone corner is concave) unless it has been pushed out through
+/// the corner, beyond the cone's extent; the shell then sends it back.
+bool on_shell_side(const Mill3D& mill, const Vec2& planar_centre, double z) {
+  if (!mill.has_cones() || (z >= 0.0 && z <= mill.length)) return true;
+  const double beyond = z < 0.0 ? -z : z - mill.length;
+  return norm(planar_centre) - mill.radius > beyond * std::tan(mill.cone_angle);
+}
+
 /// A 3D contact from the in-plane one found on the cross-section, at height z.
 WallContact<3> extrude(const WallContact<2>& planar, double z) {
   WallContact<3> contact;
@@ -132,6 +142,75 @@ WallContact<3> extrude(const WallContact<2>& planar, double z) {
   contact.point = Vec3{{planar.point[0], planar.point[1], z}};
   contact.wall_velocity = Vec3{{planar.wall_velocity[0], planar.wall_velocity[1], 0.0}};
   return contact;
+}
+
+/// A contact with an end wall of a 3D mill, a surface of revolution about the z axis, from
+/// its closest point in the meridian plane of the centre: `radial` and `axial` are that point's
+/// distance from the axis and its z, (normal_radial, normal_axial) the unit normal from the
+/// wall into the particle in that plane, `outward` the unit radial direction of the centre.
+WallContact<3> end_wall_contact(const Mill3D& mill, int wall_id, const Vec2& outward, double radial,
+                                double axial, double normal_radial, double normal_axial,
+                                double overlap) {
+  WallContact<3> contact;
+  contact.wall_id = wall_id;
+  contact.kind = WallKind::end_plate;
+  contact.normal = Vec3{{normal_radial * outward[0], normal_radial * outward[1], normal_axial}};
+  contact.overlap = overlap;
+  contact.point = Vec3{{radial * outward[0], radial * outward[1], axial}};
+  const Vec2 velocity = cross(mill.angular_speed, Vec2{{contact.point[0], contact.point[1]}});
+  contact.wall_velocity = Vec3{{velocity[0], velocity[1], 0.0}};
+  return contact;
+}
+
+/// Contacts with the conical end of a 3D mill on `side` (0: beyond z = 0, 1: beyond z =
+/// length): the cone and the trunnion plate that closes it. Works in the meridian plane of the
+/// centre, in coordinates (ρ, s): ρ the distance from the axis, s the distance beyond the end
+/// of the cylinder. The cone runs from (R, 0) to (r_t, c) along d = (−cos α, sin α), its
+/// inward normal is (−sin α, −cos α); the plate is s = c for ρ ≤ r_t. The mill's inside is
+/// convex, so a centre inside it is closest to the face of the cone or of the plate whose
+/// extent it lies across, never to the corner between them; only a centre pushed out beyond
+/// that corner (by a violent step) is sent back towards the corner itself.
+int cone_contacts(const Mill3D& mill, int side, const Vec3& centre, double particle_radius,
+                  WallContact<3>* out) {
+  const double rho = std::sqrt(centre[0] * centre[0] + centre[1] * centre[1]);
+  const double s = side == 0 ? -centre[2] : centre[2] - mill.length;
+  // Beyond z = 0 the outward axial direction is −z, beyond z = length it is +z.
+  const double axial_sign = side == 0 ? -1.0 : 1.0;
+  const double end_z = side == 0 ? 0.0 : mill.length;
+  const Vec2 outward = rho > 0.0 ? Vec2{{centre[0] / rho, centre[1] / rho}} : Vec2{{1.0, 0.0}};
+  const double sin_a = std::sin(mill.cone_angle);
+  const double cos_a = std::cos(mill.cone_angle);
+  const double c = mill.cone_length;
+  const double r_t = mill.trunnion_radius();
+  const double slant = c / sin_a;
+  const int cone_id = 1 + mill.lifter_count + side;
+  const int plate_id = cone_id + 2;
+  int count = 0;
+
+  // Along the cone from the shell, and the signed distance from it (positive inside).
+  const double along = -(rho - mill.radius) * cos_a + s * sin_a;
+  const double inside_cone = -(rho - mill.radius) * sin_a - s * cos_a;
+  if (along >= 0.0 && along <= slant && inside_cone < particle_radius) {
+    out[count++] = end_wall_contact(mill, cone_id, outward, mill.radius - along * cos_a,
+                                    end_z + axial_sign * along * sin_a, -sin_a, -axial_sign * cos_a,
+                                    particle_radius - inside_cone);
+  }
+  const double inside_plate = c - s;
+  if (rho <= r_t && inside_plate < particle_radius) {
+    out[count++] = end_wall_contact(mill, plate_id, outward, rho, end_z + axial_sign * c, 0.0,
+                                    -axial_sign, particle_radius - inside_plate);
+  }
+  if (along > slant && rho > r_t) {
+    // Beyond the corner between cone and plate: outside the mill (see above).
+    const double to_corner_radial = r_t - rho;
+    const double to_corner_axial = c - s;
+    const double distance =
+        std::sqrt(to_corner_radial * to_corner_radial + to_corner_axial * to_corner_axial);
+    out[count++] = end_wall_contact(
+        mill, plate_id, outward, r_t, end_z + axial_sign * c, to_corner_radial / distance,
+        axial_sign * to_corner_axial / distance, particle_radius + distance);
+  }
+  return count;
 }
 
 }  // namespace
@@ -163,7 +242,9 @@ int mill_contacts(const Mill3D& mill, const Vec3& centre, double particle_radius
   const Vec2 planar{{centre[0], centre[1]}};
   const double z = centre[2];
   WallContact<2> found;
-  if (shell_contact(mill, planar, particle_radius, found)) out[count++] = extrude(found, z);
+  if (shell_contact(mill, planar, particle_radius, found) && on_shell_side(mill, planar, z)) {
+    out[count++] = extrude(found, z);
+  }
   if (!beyond_lifter_reach(mill, planar, particle_radius)) {
     // Beyond an end of the bars (only while a sphere presses into an end plate) the closest
     // point is on the bar's end edge or corner, out of the plane of the centre.
@@ -176,7 +257,13 @@ int mill_contacts(const Mill3D& mill, const Vec3& centre, double particle_radius
       if (axial != 0.0) contact.normal[2] = axial / (particle_radius - found.overlap);
     });
   }
-  if (!mill.periodic) {
+  if (mill.has_cones()) {
+    // A cone is within reach only of a centre less than a radius from the end of the cylinder.
+    if (z < particle_radius) count += cone_contacts(mill, 0, centre, particle_radius, out + count);
+    if (z > mill.length - particle_radius && count < max_mill_contacts<3> - 1) {
+      count += cone_contacts(mill, 1, centre, particle_radius, out + count);
+    }
+  } else if (!mill.periodic) {
     // End plates: flat discs at z = 0 (normal +z) and z = L (normal −z), turning with the shell.
     const int first_plate = 1 + mill.lifter_count;
     for (int side = 0; side < 2; ++side) {

@@ -16,8 +16,9 @@ enum class WallKind : std::uint8_t { shell, lifter, end_plate, plane };
 /// One particle–wall contact, as seen from the wall.
 template <int D>
 struct WallContact {
-  /// 0 the shell, 1..n the lifters, in 3D then the two end plates (n + 1 at z = 0, n + 2 at
-  /// z = length) unless the mill is periodic, then the planes
+  /// 0 the shell, 1..n the lifters, in 3D then the end walls unless the mill is periodic
+  /// (n + 1 at z = 0 and n + 2 at z = length: the flat plates or the cones; with cones, n + 3
+  /// and n + 4 their trunnion plates), then the planes
   int wall_id = -1;
   WallKind kind = WallKind::shell;
   Vec<D> normal{};         ///< unit, from the wall into the particle
@@ -44,14 +45,28 @@ struct Mill2D {
 };
 
 /// A 3D mill: the cross-section of Mill2D (shell, lifters, angle, speed) extruded along the
-/// axis z from 0 to `length`, the lifters running its full length. With end plates (flat
-/// discs at z = 0 and z = length, turning with the shell) it is a whole mill; periodic, it is
-/// an axial slab whose ends wrap round (the World does the wrapping) and has no end plates.
+/// axis z from 0 to `length`, the lifters running its full length. With end plates it is a
+/// whole mill; periodic, it is an axial slab whose ends wrap round (the World does the
+/// wrapping) and has no end plates.
+///
+/// The ends are flat discs at z = 0 and z = length, or, with cone_length > 0, cones: each end
+/// is a conical wall from the shell (radius R at z = 0, or z = length) to the trunnion radius
+/// R − cone_length / tan(cone_angle) at cone_length beyond, closed there by a flat plate.
+/// cone_angle is the angle between the cone and the plane of a flat end. Everything turns
+/// with the shell. The lifters stop at the ends of the cylinder.
 struct Mill3D : Mill2D {
-  double length = 0.0;  ///< m
+  double length = 0.0;  ///< m, of the cylinder (between the cones, if any)
   bool periodic = false;
+  double cone_length = 0.0;  ///< m along the axis, each end; 0 for flat ends
+  double cone_angle = 0.0;   ///< rad, between the cone and the plane of a flat end
 
-  int end_plate_count() const { return periodic ? 0 : 2; }
+  bool has_cones() const { return !periodic && cone_length > 0.0; }
+  /// Radius of the flat plate that closes a cone (the trunnion), m.
+  double trunnion_radius() const {
+    return has_cones() ? radius - cone_length / std::tan(cone_angle) : radius;
+  }
+  /// End walls: none (periodic), two flat plates, or two cones and their two trunnion plates.
+  int end_plate_count() const { return periodic ? 0 : has_cones() ? 4 : 2; }
 };
 
 /// The mill type of each dimension.
@@ -95,13 +110,15 @@ struct Walls {
 int mill_contacts(const Mill2D& mill, const Vec2& centre, double particle_radius,
                   WallContact<2>* out);
 /// The same for a sphere in a 3D mill: the shell, up to three lifters (rectangular prisms,
-/// touched on a face, an edge or a corner, whichever is closest) and an end plate. Writes at
-/// most 5 contacts and returns how many.
+/// touched on a face, an edge or a corner, whichever is closest) and the walls of the end it
+/// is at (a flat plate, or a cone and its trunnion plate). Writes at most 6 contacts and
+/// returns how many.
 int mill_contacts(const Mill3D& mill, const Vec3& centre, double particle_radius,
                   WallContact<3>* out);
-/// Most wall contacts one particle can have with a mill.
+/// Most wall contacts one particle can have with a mill (a 3D mill is at least one ball
+/// diameter long, so a ball touches the walls of one end at most).
 template <int D>
-inline constexpr int max_mill_contacts = D == 2 ? 4 : 5;
+inline constexpr int max_mill_contacts = D == 2 ? 4 : 6;
 
 template <int D>
 bool Walls<D>::may_touch(const Vec<D>& centre, double particle_radius, double margin) const {

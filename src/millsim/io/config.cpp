@@ -33,7 +33,9 @@ const std::vector<KnownTable>& known_tables() {
   static const std::vector<KnownTable> tables = {
       {"simulation",
        {"dimension", "time_step", "settle_time", "revolutions", "measure_revolutions", "seed"}},
-      {"mill", {"diameter", "length", "speed", "speed_rpm", "periodic", "slab_length", "lifters"}},
+      {"mill",
+       {"diameter", "length", "speed", "speed_rpm", "periodic", "slab_length", "cone_angle",
+        "cone_length", "lifters"}},
       {"mill.lifters", {"count", "height", "width"}},
       {"charge", {"filling", "porosity", "density", "ball_diameter", "top_size", "sizes"}},
       {"materials", {"ball_ball", "ball_wall"}},
@@ -173,10 +175,43 @@ void read_periodic(TableReader& section, MillConfig& config) {
                      [&](double l) { return l > 0.0 && l <= config.length; });
 }
 
+/// mill.cone_angle and mill.cone_length: conical ends of a whole 3D mill, given together. The
+/// cone must end before it reaches the axis: its trunnion radius R − cone_length /
+/// tan(cone_angle) is above zero.
+void read_cones(TableReader& section, MillConfig& config) {
+  if (!section.has("cone_angle") && !section.has("cone_length")) return;
+  const std::string_view given = section.has("cone_angle") ? "cone_angle" : "cone_length";
+  if (config.dimension != 3) {
+    section.fail_at(given,
+                    "conical ends need simulation.dimension = 3; allowed: no "
+                    "mill.cone_angle or mill.cone_length in 2D (a 2D slice has no ends)");
+  }
+  if (config.periodic) {
+    section.fail_at(given,
+                    "is given but mill.periodic = true (a periodic slab has no ends); "
+                    "allowed: cone_angle and cone_length only for a whole mill");
+  }
+  const std::string both =
+      "mill.cone_angle and mill.cone_length together (conical ends), or neither (flat ends)";
+  if (!section.has("cone_angle")) section.fail_missing("cone_angle", both);
+  if (!section.has("cone_length")) section.fail_missing("cone_length", both);
+  config.cone_angle_degrees = section.number(
+      "cone_angle", std::nullopt,
+      "degrees > 0 and < 90, between the cone and the plane of a flat end (typically 15-20)",
+      [](double a) { return a > 0.0 && a < 90.0; });
+  const double longest = 0.5 * config.diameter * std::tan(config.cone_angle_degrees * pi / 180.0);
+  config.cone_length = section.number(
+      "cone_length", std::nullopt,
+      fmt::format("a number of metres > 0 and < {:.4g} (longer, a cone at {} degrees from a mill "
+                  "of {} m diameter would reach the axis)",
+                  longest, config.cone_angle_degrees, config.diameter),
+      [&](double l) { return l > 0.0 && l < longest; });
+}
+
 void read_mill(TableReader section, MillConfig& config) {
-  section.allow_keys(
-      {"diameter", "length", "speed", "speed_rpm", "periodic", "slab_length", "lifters"},
-      belongs_elsewhere);
+  section.allow_keys({"diameter", "length", "speed", "speed_rpm", "periodic", "slab_length",
+                      "cone_angle", "cone_length", "lifters"},
+                     belongs_elsewhere);
   config.diameter = section.number("diameter", std::nullopt,
                                    "a number of metres > 0 (inside the shell)", positive);
   config.length = section.number("length", std::nullopt, "a number of metres > 0", positive);
@@ -193,6 +228,7 @@ void read_mill(TableReader section, MillConfig& config) {
   }
   if (!config.speed_fraction && !config.speed_rpm) section.fail_missing("speed", either);
   read_periodic(section, config);
+  read_cones(section, config);
   read_lifters(section.table("lifters", false), config);
 }
 

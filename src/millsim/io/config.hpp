@@ -45,10 +45,12 @@ struct MillConfig {
   std::optional<double> speed_fraction;  ///< of critical speed
   std::optional<double> speed_rpm;
   int lifter_count = 0;
-  double lifter_height = 0.0;  ///< m, radial
-  double lifter_width = 0.0;   ///< m, tangential
-  bool periodic = false;       ///< 3D: simulate a periodic axial slab instead of end plates
-  double slab_length = 0.0;    ///< m, 3D periodic: the slab's length; power scales to length
+  double lifter_height = 0.0;       ///< m, radial
+  double lifter_width = 0.0;        ///< m, tangential
+  bool periodic = false;            ///< 3D: simulate a periodic axial slab instead of end plates
+  double slab_length = 0.0;         ///< m, 3D periodic: the slab's length; power scales to length
+  double cone_length = 0.0;         ///< m, 3D: axial length of each conical end; 0 = flat ends
+  double cone_angle_degrees = 0.0;  ///< 3D: angle between a cone and the plane of a flat end
 
   // [charge]
   double filling = 0.0;

@@ -28,6 +28,36 @@ bool clear_of_walls(const MillShape<D>& mill, const Vec<D>& centre, double radiu
 
 }  // namespace
 
+double circle_area_below(double radius, double level) {
+  if (level <= -radius) return 0.0;
+  if (level >= radius) return pi * radius * radius;
+  // The segment below a chord at `level`: r² acos(−y/r) + y sqrt(r² − y²).
+  return radius * radius * std::acos(-level / radius) +
+         level * std::sqrt(radius * radius - level * level);
+}
+
+double cone_bed_volume(double radius, double trunnion_radius, double cone_length, double filling) {
+  // The bed's level in the cylinder: circle_area_below(R, level) = J π R², by bisection.
+  double low = -radius;
+  double high = radius;
+  for (int n = 0; n < 200 && high - low > 1e-15 * radius; ++n) {
+    const double mid = 0.5 * (low + high);
+    (circle_area_below(radius, mid) < filling * pi * radius * radius ? low : high) = mid;
+  }
+  const double level = 0.5 * (low + high);
+  // The cone's cross-section, a circle whose radius falls linearly from R to r_t, integrated
+  // along it by Simpson's rule (the integrand is smooth but for the level's tangency).
+  constexpr int intervals = 2000;
+  const double h = cone_length / intervals;
+  double sum = 0.0;
+  for (int k = 0; k <= intervals; ++k) {
+    const double r = radius + (trunnion_radius - radius) * k / intervals;
+    const double weight = k == 0 || k == intervals ? 1.0 : (k % 2 == 1 ? 4.0 : 2.0);
+    sum += weight * circle_area_below(r, level);
+  }
+  return sum * h / 3.0;
+}
+
 MillPlan plan_mill(const MillConfig& config) {
   MillPlan plan;
   plan.config = config;
@@ -55,9 +85,25 @@ MillPlan plan_mill(const MillConfig& config) {
         config.location_of("mill.slab_length"), config.slab_length, plan.largest_ball,
         3.0 * plan.largest_ball));
   }
+  if (config.dimension == 3 && !config.periodic && config.length < plan.largest_ball) {
+    // A ball then fits nowhere, and could touch both ends at once.
+    throw InputError(fmt::format(
+        "{}: mill.length: {} m is shorter than the largest ball, {} m; allowed: a 3D mill at "
+        "least one ball diameter long",
+        config.location_of("mill.length"), config.length, plan.largest_ball));
+  }
   const double cross_section = pi * plan.radius * plan.radius;
-  plan.mill_charge_mass =
-      config.density * (1.0 - config.porosity) * config.filling * cross_section * config.length;
+  double bed_volume = config.filling * cross_section * config.length;
+  if (config.cone_length > 0.0) {
+    const double r = plan.radius;
+    const double c = config.cone_length;
+    plan.trunnion_radius = r - c / std::tan(config.cone_angle_degrees * pi / 180.0);
+    const double r_t = plan.trunnion_radius;
+    plan.cone_volume = pi * c * (r * r + r * r_t + r_t * r_t) / 3.0;
+    plan.cone_bed_volume = cone_bed_volume(r, r_t, c, config.filling);
+    bed_volume += 2.0 * plan.cone_bed_volume;
+  }
+  plan.mill_charge_mass = config.density * (1.0 - config.porosity) * bed_volume;
   if (config.dimension == 2) {
     // Discs: the bed fills J of the slice with a 2D void fraction; each size class takes its
     // mass fraction of the disc area (a section through a 3D charge shows each size with its
@@ -138,6 +184,8 @@ World<D> build_mill_world(const MillPlan& plan) {
   if constexpr (D == 3) {
     mill.length = plan.simulated_length;
     mill.periodic = config.periodic;
+    mill.cone_length = config.cone_length;
+    mill.cone_angle = config.cone_angle_degrees * pi / 180.0;
   }
   mill.turn_to(0.0);
   walls.mill = mill;
@@ -153,8 +201,9 @@ World<D> build_mill_world(const MillPlan& plan) {
   std::array<double, D> low{};
   std::array<double, D> span{};
   for (int a = 0; a < D; ++a) {
-    low[a] = a < 2 ? -plan.radius : 0.0;
-    span[a] = a < 2 ? 2.0 * plan.radius : plan.simulated_length;
+    // Along the axis: the cylinder, and the cones beyond its ends.
+    low[a] = a < 2 ? -plan.radius : -config.cone_length;
+    span[a] = a < 2 ? 2.0 * plan.radius : plan.simulated_length + 2.0 * config.cone_length;
     cells[a] = static_cast<int>(std::ceil(span[a] / cell)) + 1;
   }
   const bool periodic = D == 3 && config.periodic;

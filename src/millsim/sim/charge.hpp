@@ -34,8 +34,15 @@ struct MillPlan {
   double revolution_period = 0.0;  ///< s
   std::vector<DiscClass> discs;
   int particle_count = 0;
-  double slice_mass = 0.0;        ///< kg, the simulated discs or balls
-  double mill_charge_mass = 0.0;  ///< kg, ρ (1 − porosity) J π R² L
+  double slice_mass = 0.0;  ///< kg, the simulated discs or balls
+  /// kg, ρ (1 − porosity) (J π R² L + 2 cone_bed_volume): the cylinder's bed, and with
+  /// conical ends the bed in each cone below the same level
+  double mill_charge_mass = 0.0;
+  double trunnion_radius = 0.0;  ///< m, 3D with conical ends: where each cone is closed
+  double cone_volume = 0.0;      ///< m³, inside one conical end (a frustum)
+  /// m³, voids included: the part of one cone below the level of a bed filling J of the
+  /// cylinder
+  double cone_bed_volume = 0.0;
   /// Simulated power × power_scale = the mill's: mill_charge_mass / slice_mass in 2D,
   /// length / simulated_length in 3D (1 for a whole mill).
   double power_scale = 0.0;
@@ -46,6 +53,14 @@ struct MillPlan {
   double time_step = 0.0;                   ///< s, in use
   double total_time = 0.0;                  ///< s, settling + rotation
 };
+
+/// Area of the part of a circle of `radius` below the horizontal line at `level` from its
+/// centre (negative: below the centre), m².
+double circle_area_below(double radius, double level);
+/// Volume, voids included, of the bed in one conical end: the part of a frustum (radius R at
+/// the cylinder, r_t at the trunnion, `cone_length` long) below the level of a bed that fills
+/// `filling` of the cylinder's cross-section, m³.
+double cone_bed_volume(double radius, double trunnion_radius, double cone_length, double filling);
 
 /// Works out the plan; throws InputError when the config asks for the impossible (an unstable
 /// time step), naming the key.

@@ -35,8 +35,9 @@ struct EnergyAccount {
 template <int D>
 class World {
  public:
-  /// Per particle: shell and up to three lifters, and in 3D an end plate (and one spare).
-  static constexpr int max_wall_contacts = D == 2 ? 4 : 6;
+  /// Per particle: the shell and up to three lifters; in 3D also the walls of one end (a
+  /// flat plate, or a cone and its trunnion plate) and one spare.
+  static constexpr int max_wall_contacts = D == 2 ? 4 : max_mill_contacts<3> + 1;
 
   World(const WorldSettings<D>& settings, const Walls<D>& walls);
 
