@@ -178,7 +178,8 @@ void write_snapshot(const std::filesystem::path& directory, int index, const Wor
   out.print("# time_s = {:.9g}, shell_angle_rad = {:.9g}\n", world.time(),
             world.walls().mill ? world.walls().mill->angle : 0.0);
   out.print("id,x,y,z,vx,vy,vz,wx,wy,wz,radius,fx,fy,fz\n");
-  for (std::size_t i = 0; i < p.size(); ++i) {
+  for (std::size_t id = 0; id < p.size(); ++id) {
+    const std::size_t i = world.particle_index(id);
     const Vec3& x = p.position[i];
     const Vec3& v = p.velocity[i];
     const Vec3& w = p.angular_velocity[i];
@@ -186,7 +187,7 @@ void write_snapshot(const std::filesystem::path& directory, int index, const Wor
     out.print(
         "{},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},"
         "{:.7g},{:.7g}\n",
-        i, x[0], x[1], x[2], v[0], v[1], v[2], w[0], w[1], w[2], p.radius[i], f[0], f[1], f[2]);
+        id, x[0], x[1], x[2], v[0], v[1], v[2], w[0], w[1], w[2], p.radius[i], f[0], f[1], f[2]);
   }
 }
 
@@ -197,8 +198,9 @@ void write_snapshot(const std::filesystem::path& directory, int index, const Wor
   out.print("# time_s = {:.9g}, shell_angle_rad = {:.9g}\n", world.time(),
             world.walls().mill ? world.walls().mill->angle : 0.0);
   out.print("id,x,y,vx,vy,omega,radius,fx,fy\n");
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    out.print("{},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g}\n", i, p.position[i][0],
+  for (std::size_t id = 0; id < p.size(); ++id) {
+    const std::size_t i = world.particle_index(id);
+    out.print("{},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g}\n", id, p.position[i][0],
               p.position[i][1], p.velocity[i][0], p.velocity[i][1], p.angular_velocity[i],
               p.radius[i], p.force[i][0], p.force[i][1]);
   }

@@ -12,8 +12,8 @@ namespace millsim {
 
 struct MillResult;
 
-/// snapshots/snapshot_NNNNNN.csv: time, and per particle id, position, velocity, angular
-/// velocity, radius and net force.
+/// snapshots/snapshot_NNNNNN.csv: time, and per particle, in the order of their ids (World's
+/// particle_id), the id, position, velocity, angular velocity, radius and net force.
 void write_snapshot(const std::filesystem::path& directory, int index, const World<2>& world);
 void write_snapshot(const std::filesystem::path& directory, int index, const World<3>& world);
 

@@ -26,6 +26,21 @@ struct ParticleStore {
 
   std::size_t size() const { return position.size(); }
 
+  /// Calls f on every per-particle array above, for code that must treat them all alike
+  /// (World's reordering into cell order): an array added above belongs in this list too.
+  template <typename F>
+  void for_each_array(F&& f) {
+    f(position);
+    f(velocity);
+    f(angular_velocity);
+    f(force);
+    f(torque);
+    f(radius);
+    f(mass);
+    f(inverse_mass);
+    f(inverse_inertia);
+  }
+
   /// Adds a particle at rest unless told otherwise. In 2D, `mass` is whatever the caller
   /// decides a disc carries (millsim's mills give each disc the mass of its sphere).
   std::size_t add(const Vec<D>& at, double particle_radius, double particle_mass,

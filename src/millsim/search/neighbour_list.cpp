@@ -26,11 +26,12 @@ bool NeighbourList<D>::needs_refresh(const std::vector<Vec<D>>& position) const 
 
 template <int D>
 void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
-                               const std::vector<double>& radius) {
+                               const std::vector<double>& radius, bool into_cell_order) {
   const std::size_t count = position.size();
   ++rebuild_count_;
   next_first_.clear();
   next_second_.clear();
+  previous_index_.clear();
   if (count > 0) {
     // Cells of side the smallest cut-off distance (two of the smallest particles), grown if
     // the particles are spread so wide that the grid would hold many more cells than
@@ -98,19 +99,29 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       cell_position_[slot] = position[i];
       cell_radius_[slot] = radius[i];
     }
+    if (into_cell_order) {
+      // Particles are renumbered by their place in the cells: from here on a member's index
+      // is its slot.
+      previous_index_.assign(cell_members_.begin(), cell_members_.end());
+      for (std::size_t slot = 0; slot < count; ++slot) {
+        cell_members_[slot] = static_cast<std::uint32_t>(slot);
+      }
+    }
 
-    // Pairs found from particle i (see above) go to `found`.
-    const auto search_from = [&](std::size_t i,
+    // Pairs found from the particle in `slot` (see above) go to `found`.
+    const auto search_from = [&](std::size_t slot,
                                  std::vector<std::pair<std::uint32_t, std::uint32_t>>& found) {
-      const double own_radius = radius[i];
-      const Vec<D> own_position = position[i];
+      const std::uint32_t i = cell_members_[slot];
+      const double own_radius = cell_radius_[slot];
+      const Vec<D> own_position = cell_position_[slot];
+      const std::array<long, D>& own_home = home[into_cell_order ? previous_index_[slot] : i];
       const double cutoff = 2.0 * own_radius + skin_;  // the farthest a smaller partner can be
       std::array<long, D> from{};
       std::array<long, D> to{};
       for (int a = 0; a < D; ++a) {
         const long range = static_cast<long>(std::ceil(cutoff / side[a]));
-        from[a] = home[i][a] - range;
-        to[a] = home[i][a] + range;
+        from[a] = own_home[a] - range;
+        to[a] = own_home[a] + range;
         if (periodic && a == D - 1 && to[a] - from[a] + 1 >= cells[a]) {
           from[a] = 0;  // the range wraps onto itself: visit every cell along the axis once
           to[a] = cells[a] - 1;
@@ -131,8 +142,7 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
           if (other_radius == own_radius && j <= i) continue;
           const double reach = own_radius + other_radius + skin_;
           if (norm_squared(separation(own_position, cell_position_[k])) < reach * reach) {
-            const auto self = static_cast<std::uint32_t>(i);
-            found.push_back(self < j ? std::pair{self, j} : std::pair{j, self});
+            found.push_back(i < j ? std::pair{i, j} : std::pair{j, i});
           }
         }
       };
@@ -163,7 +173,7 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       found.clear();
       const std::size_t chunk_end = std::min(count, (chunk + 1) * search_chunk);
       for (std::size_t member = chunk * search_chunk; member < chunk_end; ++member) {
-        search_from(cell_members_[member], found);
+        search_from(member, found);
       }
     }
     // Sorted by (first, second): a counting sort by first, then each first's seconds.
@@ -190,20 +200,34 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       begin = end;
     }
   }
-  // Carry the history of pairs kept from the old list: both lists are sorted by (first, second).
+  // Carry the history of pairs kept from the old list, found among the old pairs of the lower
+  // of the two old indices. A pair whose particles were renumbered in the other order has its
+  // bodies A and B swapped: its tangential spring, the force on B, changes sign (the other
+  // quantities of the history are the same for both bodies).
   next_history_.assign(next_first_.size(), ContactHistory<D>{});
-  std::size_t old = 0;
-  for (std::size_t p = 0; p < next_first_.size() && old < first_.size(); ++p) {
-    const auto key = std::pair{next_first_[p], next_second_[p]};
-    while (old < first_.size() && std::pair{first_[old], second_[old]} < key) ++old;
-    if (old < first_.size() && std::pair{first_[old], second_[old]} == key) {
+  const std::size_t old_count = first_begin_.empty() ? 0 : first_begin_.size() - 1;
+  for (std::size_t p = 0; p < next_first_.size(); ++p) {
+    std::uint32_t a = into_cell_order ? previous_index_[next_first_[p]] : next_first_[p];
+    std::uint32_t b = into_cell_order ? previous_index_[next_second_[p]] : next_second_[p];
+    const bool swapped = a > b;
+    if (swapped) std::swap(a, b);
+    if (b >= old_count) continue;  // a particle added since the last rebuild
+    for (std::uint32_t old = first_begin_[a]; old < first_begin_[a + 1] && second_[old] <= b;
+         ++old) {
+      if (second_[old] != b) continue;
       next_history_[p] = history_[old];
+      if (swapped) next_history_[p].tangential_spring = -history_[old].tangential_spring;
+      break;
     }
   }
   first_.swap(next_first_);
   second_.swap(next_second_);
   history_.swap(next_history_);
-  reference_position_ = position;
+  if (into_cell_order && count > 0) {
+    reference_position_.assign(cell_position_.begin(), cell_position_.end());
+  } else {
+    reference_position_ = position;
+  }
 
   // Per-particle views of the pair list (counting sorts; pairs are already ordered by first).
   first_begin_.assign(count + 1, 0);

@@ -37,7 +37,14 @@ class NeighbourList {
   bool needs_refresh(const std::vector<Vec<D>>& position) const;
 
   /// Rebuilds the pair list, sorted by (first, second), carrying each kept pair's history.
-  void rebuild(const std::vector<Vec<D>>& position, const std::vector<double>& radius);
+  /// With into_cell_order, the particles are also renumbered in the order of the grid's cells,
+  /// so that particles near each other in space are near each other in memory: the new list
+  /// is in the new numbers, previous_index() says which particle each one was, and the caller
+  /// must reorder every per-particle array of its own (position and radius too) the same way.
+  void rebuild(const std::vector<Vec<D>>& position, const std::vector<double>& radius,
+               bool into_cell_order = false);
+  /// After a rebuild into cell order, for each new index the particle's index before it.
+  const std::vector<std::uint32_t>& previous_index() const { return previous_index_; }
 
   std::size_t pair_count() const { return first_.size(); }
   const std::vector<std::uint32_t>& first() const { return first_; }
@@ -68,6 +75,7 @@ class NeighbourList {
   std::vector<double> cell_radius_;
   std::vector<std::uint32_t> next_first_, next_second_;
   std::vector<std::array<long, D>> particle_home_;
+  std::vector<std::uint32_t> previous_index_;
   std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found_;  // per search chunk
   std::vector<std::uint32_t> pair_cursor_;
   std::vector<ContactHistory<D>> next_history_;

@@ -64,6 +64,7 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
                     const std::filesystem::path& snapshot_directory,
                     const ProgressCallback& progress) {
   const auto started = std::chrono::steady_clock::now();
+  world.set_cell_order_interval(cell_order_interval);
   MillResult result;
   result.plan = plan;
   const double dt = plan.time_step;

@@ -66,11 +66,13 @@ std::pair<Vec<D>, Spin<D>> current_motion(const World<D>& world, std::size_t i) 
           p.angular_velocity[i] + (half * p.inverse_inertia[i]) * p.torque[i]};
 }
 
+/// Every particle's row, in the order of their ids (the order of the config).
 template <int D>
 void write_state(std::FILE* file, const World<D>& world) {
-  for (std::size_t i = 0; i < world.particles().size(); ++i) {
+  for (std::size_t id = 0; id < world.particles().size(); ++id) {
+    const std::size_t i = world.particle_index(id);
     const auto [v, w] = current_motion(world, i);
-    write_row<D>(file, world.time(), i, world.particles().position[i], v, w);
+    write_row<D>(file, world.time(), id, world.particles().position[i], v, w);
   }
 }
 
@@ -224,6 +226,7 @@ World<D> build_scene_world(const ScenePlan& plan) {
   for (const SceneWall& w : c.walls)
     walls.planes.push_back({to_vec<D>(w.point), to_vec<D>(w.normal)});
   World<D> world(settings, walls);
+  world.set_cell_order_interval(cell_order_interval);
   for (const SceneParticle& p : c.particles) {
     // u̇(−½) = u̇(0) − ½ g Δt: no contact force acts at the start (nothing overlaps).
     const Vec<D> half_step_back = to_vec<D>(p.velocity) - (0.5 * plan.time_step) * settings.gravity;
@@ -275,7 +278,8 @@ SceneResult run_scene_in(const ScenePlan& plan, const std::filesystem::path& dir
   result.simulated_seconds = world.time();
   result.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_clock).count();
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t id = 0; id < n; ++id) {
+    const std::size_t i = world.particle_index(id);
     const auto [v, w] = current_motion(world, i);
     result.kinetic_end += kinetic_energy(p, i, v, w);
   }

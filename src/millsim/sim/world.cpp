@@ -1,6 +1,7 @@
 #include "millsim/sim/world.hpp"
 
 #include <algorithm>
+#include <type_traits>
 
 namespace millsim {
 namespace {
@@ -27,6 +28,21 @@ constexpr std::size_t parallel_threshold = 2048;
 
 std::size_t block_count(std::size_t items, std::size_t block) {
   return (items + block - 1) / block;
+}
+
+/// values[k] ← values[previous[k]] for blocks of `per_particle` elements, through `scratch`
+/// (swapped with `values`: it keeps the old buffer for the next array of its type).
+template <typename T>
+void reorder(std::vector<T>& values, const std::vector<std::uint32_t>& previous,
+             std::size_t per_particle, std::vector<T>& scratch) {
+  scratch.resize(values.size());
+  for (std::size_t k = 0; k < previous.size(); ++k) {
+    const std::size_t from = previous[k] * per_particle;
+    std::copy(values.begin() + static_cast<std::ptrdiff_t>(from),
+              values.begin() + static_cast<std::ptrdiff_t>(from + per_particle),
+              scratch.begin() + static_cast<std::ptrdiff_t>(k * per_particle));
+  }
+  values.swap(scratch);
 }
 
 }  // namespace
@@ -78,6 +94,11 @@ void World<D>::refresh_neighbours() {
     wall_slot_id_.assign(count * max_wall_contacts, -1);
     wall_slot_history_.assign(count * max_wall_contacts, ContactHistory<D>{});
   }
+  // Particles added since the last step are at the end, each with its index as id.
+  for (std::size_t i = particle_id_.size(); i < count; ++i) {
+    particle_id_.push_back(static_cast<std::uint32_t>(i));
+    particle_index_.push_back(static_cast<std::uint32_t>(i));
+  }
   if (!neighbours_.needs_refresh(particles_.position)) return;
   if (settings_.skin <= 0.0 && count > 0) {
     const double smallest = *std::min_element(particles_.radius.begin(), particles_.radius.end());
@@ -85,7 +106,10 @@ void World<D>::refresh_neighbours() {
     neighbours_ = NeighbourList<D>(settings_.skin);
     neighbours_.set_period(axial_period());
   }
-  neighbours_.rebuild(particles_.position, particles_.radius);
+  const bool into_cell_order =
+      cell_order_interval_ > 0 && neighbours_.rebuild_count() % cell_order_interval_ == 0;
+  neighbours_.rebuild(particles_.position, particles_.radius, into_cell_order);
+  if (into_cell_order) reorder_particles(neighbours_.previous_index());
   // Pair forces start at zero and return to zero when a contact ends, so that a pair that is
   // not touching costs no store (evaluate_pair_contacts).
   const std::size_t pairs = neighbours_.pair_count();
@@ -132,6 +156,65 @@ void World<D>::refresh_neighbours() {
   wall_block_dissipated_.resize(block_count(candidates, wall_block));
   wall_block_torque_.resize(block_count(candidates, wall_block));
   wall_block_work_.resize(block_count(candidates, wall_block));
+}
+
+template <int D>
+void World<D>::reorder_particles(const std::vector<std::uint32_t>& previous) {
+  // Everything per particle that lasts beyond this step is reordered; what the step rewrites
+  // before reading it again (velocity_now_, spin_now_, wall forces and dashpots) is not.
+  particles_.for_each_array([&](auto& values) {
+    using Element = typename std::decay_t<decltype(values)>::value_type;
+    reorder(values, previous, 1, std::get<std::vector<Element>>(reorder_scratch_));
+  });
+  reorder(particle_id_, previous, 1, std::get<std::vector<std::uint32_t>>(reorder_scratch_));
+  reorder_wall_slots(previous);
+  for (std::size_t k = 0; k < particle_id_.size(); ++k) {
+    particle_index_[particle_id_[k]] = static_cast<std::uint32_t>(k);
+  }
+}
+
+template <int D>
+void World<D>::reorder_wall_slots(const std::vector<std::uint32_t>& previous) {
+  // In place, one cycle of the permutation at a time: slot k takes the slots of previous[k],
+  // whose own are taken next, until the cycle closes on the slots held from its start.
+  const std::size_t count = previous.size();
+  constexpr auto slots = static_cast<std::size_t>(max_wall_contacts);
+  const auto move = [&](std::size_t from, std::size_t to) {
+    std::copy_n(&wall_slot_id_[from * slots], slots, &wall_slot_id_[to * slots]);
+    std::copy_n(&wall_slot_history_[from * slots], slots, &wall_slot_history_[to * slots]);
+  };
+  reorder_moved_.assign(count, 0);
+  for (std::size_t start = 0; start < count; ++start) {
+    if (reorder_moved_[start] != 0) continue;
+    std::array<std::int32_t, slots> held_id;
+    std::array<ContactHistory<D>, slots> held_history;
+    std::copy_n(&wall_slot_id_[start * slots], slots, held_id.begin());
+    std::copy_n(&wall_slot_history_[start * slots], slots, held_history.begin());
+    std::size_t k = start;
+    for (;;) {
+      reorder_moved_[k] = 1;
+      const std::size_t from = previous[k];
+      if (from == start) break;
+      move(from, k);
+      k = from;
+    }
+    std::copy_n(held_id.begin(), slots, &wall_slot_id_[k * slots]);
+    std::copy_n(held_history.begin(), slots, &wall_slot_history_[k * slots]);
+  }
+}
+
+template <int D>
+ParticleStore<D> World<D>::particles_by_id() const {
+  std::vector<std::uint32_t> index_of_id(particles_.size());
+  for (std::size_t id = 0; id < index_of_id.size(); ++id) {
+    index_of_id[id] = static_cast<std::uint32_t>(particle_index(id));
+  }
+  ParticleStore<D> by_id = particles_;
+  by_id.for_each_array([&](auto& values) {
+    std::decay_t<decltype(values)> scratch;
+    reorder(values, index_of_id, 1, scratch);
+  });
+  return by_id;
 }
 
 template <int D>

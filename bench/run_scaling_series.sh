@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# Issue 5, target 3: particle-steps per second from 1e3 to 1e6 balls (3D), and memory per
+# particle. Settling 1e6 balls from random placement is far too expensive, so the series tiles
+# a settled periodic slab (bench/scaling-mill.toml: 996 balls of 10 mm in a 0.041 m slab of a
+# 0.3 m mill at 75 % of critical, dt 1.516e-5 s = 1/15 of the ball-ball contact):
+#
+#   1. settle the slab once (0.8 s, shell still), turn it 33 000 steps (0.5 s, half a
+#      revolution) and save the state (kept in the work directory, reused while the command is
+#      the same);
+#   2. for K = 1, 10, 100, 1000 (996 ... 996 000 balls) start from that state with
+#      `millsim_scene_bench --load-state ... --tile K`: K copies of the slab end to end, a slab
+#      K times longer; a warmup, then a fixed number of timed steps (fewer for larger K, at
+#      least four neighbour-list rebuilds);
+#   3. the same with --shuffle (the particles' order in memory drawn at random) at K = 1 and
+#      K = 1000: tiling copies the base slab's memory order in blocks, which keeps neighbours in
+#      space near in memory; a freshly placed 1e6 charge has no such luck.
+#
+# Prints one row per point (particles, steps, wall and CPU seconds, particle-steps per wall and
+# per CPU second, bytes per particle: resident growth and the array estimate, neighbour-list
+# rebuilds), then the ratio of the slowest to the fastest rate of the ordered series. CPU time
+# is the figure to read on a shared machine. About 10 minutes of CPU time on one thread;
+# 2.3 GB of memory at the largest point.
+#
+#   bench/run_scaling_series.sh [THREADS]          (default: 1 thread)
+#
+# Environment: MILLSIM_BUILD (a build directory to use as it is; default build/release, built
+# with the release preset), SCALING_WORK (work directory for the state and the full outputs,
+# default runs/bench/scaling).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+threads=${1:-1}
+case "$threads" in ''|*[!0-9]*|0) echo "usage: $0 [THREADS]" >&2; exit 2 ;; esac
+config=bench/scaling-mill.toml
+work=${SCALING_WORK:-runs/bench/scaling}
+build=${MILLSIM_BUILD:-build/release}
+
+if [ -z "${MILLSIM_BUILD:-}" ]; then
+  bash scripts/install-deps.sh
+  cmake --preset release >/dev/null
+  cmake --build --preset release --target millsim_scene_bench >/dev/null
+fi  # a given MILLSIM_BUILD is used as it is (not rebuilt)
+bench="$build/bench/millsim_scene_bench"
+
+echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'), $(nproc) cores;" \
+  "load average $(cut -d' ' -f1-3 /proc/loadavg); $threads thread(s)"
+echo "millsim: $build ($(git rev-parse --short HEAD 2>/dev/null || echo 'not a git tree')$(git diff --quiet 2>/dev/null || echo ', with uncommitted changes'))"
+
+mkdir -p "$work"
+state="$work/base.state"
+base_cmd=("$bench" "$config" --warmup 0 --steps 33000 -j 1 --save-state "$state")
+if [ -f "$state" ] && [ "$(cat "$work/base.cmd" 2>/dev/null)" = "${base_cmd[*]}" ]; then
+  echo "base slab: reusing $state"
+else
+  echo "base slab: settling and turning it once (1 thread): ${base_cmd[*]}"
+  rm -f "$work/base.cmd"
+  "${base_cmd[@]}" > "$work/base.txt"
+  grep -E '^(particles|prepared|timed)' "$work/base.txt"
+  echo "${base_cmd[*]}" > "$work/base.cmd"
+fi
+
+# One point: K, warmup steps, timed steps, then extra options. Full output in $work.
+rates=()
+point() {
+  local tile=$1 warmup=$2 steps=$3
+  shift 3
+  local name="tile-$tile${1:+-${1#--}}-j$threads"
+  "$bench" "$config" --load-state "$state" --tile "$tile" --warmup "$warmup" --steps "$steps" \
+    -j "$threads" "$@" > "$work/$name.txt"
+  awk -v tile="$tile" -v extra="${*:-}" '
+    /^particles /           { n = $2 }
+    /^timed steps/          { steps = $3; wall = $5; cpu = $10; sub(/^\(/, "", cpu) }
+    /^particle-steps\/s/    { rate_wall = $2; rate_cpu = $5 }
+    /^neighbour rebuilds/   { rebuilds = $3 }
+    /^memory\/particle/     { resident = $2 }
+    /^memory estimate/      { estimate = $3 }
+    END { printf "| %d%s | %d | %d | %.1f | %.1f | %.3g | %.3g | %d | %d | %d |\n", tile,
+            extra == "" ? "" : " " extra, n, steps, wall, cpu, rate_wall, rate_cpu, resident,
+            estimate, rebuilds }' "$work/$name.txt" | tee -a "$work/table-j$threads.md"
+  [ -z "${1:-}" ] && rates+=("$(awk '/^particle-steps\/s/ {print $5, $2}' "$work/$name.txt")")
+  return 0
+}
+
+echo
+echo "| K | particles | timed steps | wall s | CPU s | particle-steps/s (wall) | particle-steps/s (CPU) | bytes/particle (resident) | bytes/particle (arrays) | rebuilds |"
+echo "|---|---|---|---|---|---|---|---|---|---|"
+: > "$work/table-j$threads.md"
+point 1 2000 100000
+point 10 500 10000
+point 100 100 1000
+point 1000 50 300
+point 1 2000 100000 --shuffle
+point 1000 50 300 --shuffle
+
+printf '%s\n' "${rates[@]}" | awk '
+  NR == 1 || $1 < cpu_low  { cpu_low = $1 }
+  NR == 1 || $1 > cpu_high { cpu_high = $1 }
+  NR == 1 || $2 < wall_low  { wall_low = $2 }
+  NR == 1 || $2 > wall_high { wall_high = $2 }
+  END { printf "\nordered series, K = 1 ... 1000, slowest / fastest particle-steps per second:" \
+          " %.3f per CPU second, %.3f per wall second (issue 5: within 30 %%:\n" \
+          "  at least 0.70 of the fastest; 0.77 if read as fastest / slowest <= 1.3)\n",
+          cpu_low / cpu_high, wall_low / wall_high }'
