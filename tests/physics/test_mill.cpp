@@ -9,6 +9,7 @@
 #include "millsim/builtin_example.hpp"
 #include "millsim/core/constants.hpp"
 #include "millsim/sim/mill_run.hpp"
+#include "support/energy_account.hpp"
 
 namespace millsim {
 namespace {
@@ -80,15 +81,7 @@ TEST(Mill, TumblesBelowCriticalAndCentrifugesAboveIt) {
 TEST(Mill, EnergyAccountClosesAndBothPowersAgree) {
   const MillResult r =
       run(lab_mill({"simulation.revolutions=4", "simulation.measure_revolutions=3"}));
-  const double work = r.window_end.shell_work - r.window_start.shell_work;
-  const double change = (r.window_end.kinetic - r.window_start.kinetic) +
-                        (r.window_end.potential - r.window_start.potential) +
-                        (r.window_end.stored - r.window_start.stored);
-  const double dissipated = r.window_end.dissipated - r.window_start.dissipated;
-  EXPECT_GT(work, 0.0);
-  EXPECT_NEAR(change + dissipated, work, 0.01 * work) << "shell work = Δenergy + dissipated";
-  EXPECT_LT(r.energy_balance_error, 0.01);
-  EXPECT_NEAR(r.power_dissipation_kw, r.power_kw, 0.03 * r.power_kw);
+  testing::expect_energy_account_closes(r);
 }
 
 }  // namespace
