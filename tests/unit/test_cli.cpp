@@ -247,8 +247,8 @@ TEST_F(Cli, InfoOfAConicalMillPrintsItsCones) {
 
 TEST_F(Cli, RefusesConesOnA2DMill) {
   const std::string text = with(base_config, "speed", "speed = 0.5\ncone_angle = 15");
-  expect_refused(run_config(text), {at_line(text, "cone_angle"), "mill.cone_angle",
-                                    "simulation.dimension = 3"});
+  expect_refused(run_config(text),
+                 {at_line(text, "cone_angle"), "mill.cone_angle", "simulation.dimension = 3"});
 }
 
 TEST_F(Cli, RefusesANamedTimeStepOtherThanAuto) {
