@@ -192,7 +192,7 @@ ArrayEstimate estimate_array_bytes(const millsim::World<D>& world) {
   using millsim::Spin;
   using millsim::Vec;
   const millsim::ParticleStore<D>& p = world.particles();
-  millsim::NeighbourList<D> list(world.settings().skin);
+  millsim::NeighbourList<D> list(world.neighbour_skin());
   if constexpr (D == 3) {
     if (world.walls().mill->periodic) list.set_period(world.walls().mill->length);
   }
@@ -291,9 +291,11 @@ void report(const millsim::MillPlan& plan, const BenchOptions& options,
   fmt::print("particle-steps/s  {:.4g} (wall clock); {:.4g} per CPU second\n",
              particle_steps / measured.wall_seconds, particle_steps / measured.cpu_seconds);
   fmt::print(
-      "neighbour rebuilds {} ({:.1f} steps apart), {} contacts at the end\n", measured.rebuilds,
+      "neighbour rebuilds {} ({:.1f} steps apart, skin {:.3g} mm at the end), {} contacts at the "
+      "end\n",
+      measured.rebuilds,
       static_cast<double>(options.steps) / static_cast<double>(std::max(1L, measured.rebuilds)),
-      world.touching_contacts());
+      1e3 * world.neighbour_skin(), world.touching_contacts());
   fmt::print("real-time factor  {:.4g} (mill seconds per wall second)\n",
              static_cast<double>(options.steps) * plan.time_step / measured.wall_seconds);
   fmt::print("memory/particle   {:.0f} bytes (resident growth while building and running {})\n",

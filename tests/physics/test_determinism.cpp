@@ -106,7 +106,7 @@ Outcome<D> step_on(const World<D>& scene, int steps, int threads) {
 template <int D>
 std::size_t listed_pairs(const World<D>& world) {
   const auto& p = world.particles();
-  const double skin = world.settings().skin;
+  const double skin = world.neighbour_skin();
   double period = 0.0;
   if constexpr (D == 3) {
     if (world.walls().mill->periodic) period = world.walls().mill->length;
@@ -129,7 +129,7 @@ std::size_t wall_candidates(const World<D>& world) {
   const auto& p = world.particles();
   std::size_t candidates = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    if (world.walls().may_touch(p.position[i], p.radius[i], world.settings().skin)) ++candidates;
+    if (world.walls().may_touch(p.position[i], p.radius[i], world.neighbour_skin())) ++candidates;
   }
   return candidates;
 }
@@ -218,8 +218,9 @@ TEST(Determinism, SagMill2DIsTheSameOnOneAndTwoThreads) {
 
 /// A short, wide 3D mill full of 1 cm balls: 0.8 m across and only 3 cm long between its end
 /// plates (or a periodic slab of 3 cm), sixteen 2 × 2 cm lifters, J = 0.3, 80 % of critical
-/// speed. About 5 000 balls; with end plates two thirds of them lie within a skin (a ball
-/// radius) of one, so the wall stage has thousands of candidates.
+/// speed. About 5 000 balls; with end plates, the 3 cm between them are three ball diameters,
+/// so thousands of balls lie within a skin of one and the wall stage has thousands of
+/// candidates (checked below).
 std::string short_wide_mill(bool periodic) {
   return fmt::format(R"(
 [simulation]

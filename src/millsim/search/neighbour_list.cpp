@@ -29,6 +29,7 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
                                const std::vector<double>& radius, bool into_cell_order) {
   const std::size_t count = position.size();
   ++rebuild_count_;
+  skin_ = next_skin_;
   next_first_.clear();
   next_second_.clear();
   previous_index_.clear();

@@ -18,7 +18,11 @@ template <int D>
 class NeighbourList {
  public:
   /// skin: extra distance beyond contact within which pairs are listed, m (> 0).
-  explicit NeighbourList(double skin) : skin_(skin) {}
+  explicit NeighbourList(double skin) : skin_(skin), next_skin_(skin) {}
+
+  /// The skin of the lists built from the next rebuild on. The current list keeps the skin it
+  /// was built with, and needs_refresh() keeps judging it by that one.
+  void set_skin(double skin) { next_skin_ = skin; }
 
   /// Makes the last axis periodic with this period, m (0: not periodic). Positions along it
   /// must lie in [0, period), and the period must exceed twice the largest cut-off distance
@@ -59,10 +63,12 @@ class NeighbourList {
   const std::vector<std::uint32_t>& second_begin() const { return second_begin_; }
   const std::vector<std::uint32_t>& second_pairs() const { return second_pairs_; }
   long rebuild_count() const { return rebuild_count_; }
+  /// The skin the current list was built with, m.
   double skin() const { return skin_; }
 
  private:
   double skin_;
+  double next_skin_;
   double period_ = 0.0;
   long rebuild_count_ = 0;
   std::vector<std::uint32_t> first_, second_;

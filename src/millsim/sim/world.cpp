@@ -100,12 +100,8 @@ void World<D>::refresh_neighbours() {
     particle_index_.push_back(static_cast<std::uint32_t>(i));
   }
   if (!neighbours_.needs_refresh(particles_.position)) return;
-  if (settings_.skin <= 0.0 && count > 0) {
-    const double smallest = *std::min_element(particles_.radius.begin(), particles_.radius.end());
-    settings_.skin = smallest;
-    neighbours_ = NeighbourList<D>(settings_.skin);
-    neighbours_.set_period(axial_period());
-  }
+  const double skin = settings_.skin > 0.0 ? settings_.skin : choose_skin();
+  neighbours_.set_skin(skin);
   const bool into_cell_order =
       cell_order_interval_ > 0 && neighbours_.rebuild_count() % cell_order_interval_ == 0;
   neighbours_.rebuild(particles_.position, particles_.radius, into_cell_order);
@@ -136,7 +132,7 @@ void World<D>::refresh_neighbours() {
   wall_force_.assign(count, Vec<D>{});
   wall_moment_.assign(count, Spin<D>{});
   for (std::size_t i = 0; i < count; ++i) {
-    if (walls_.may_touch(particles_.position[i], particles_.radius[i], settings_.skin)) {
+    if (walls_.may_touch(particles_.position[i], particles_.radius[i], skin)) {
       wall_candidates_.push_back(static_cast<std::uint32_t>(i));
       continue;
     }
@@ -156,6 +152,20 @@ void World<D>::refresh_neighbours() {
   wall_block_dissipated_.resize(block_count(candidates, wall_block));
   wall_block_torque_.resize(block_count(candidates, wall_block));
   wall_block_work_.resize(block_count(candidates, wall_block));
+}
+
+template <int D>
+double World<D>::choose_skin() const {
+  const auto& p = particles_;
+  if (p.size() == 0) return 0.0;
+  double smallest = p.radius[0];
+  double fastest_squared = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    smallest = std::min(smallest, p.radius[i]);
+    fastest_squared = std::max(fastest_squared, norm_squared(p.velocity[i]));
+  }
+  const double lasting = 2.0 * skin_target_steps * settings_.time_step * std::sqrt(fastest_squared);
+  return std::clamp(lasting, skin_floor * smallest, skin_ceiling * smallest);
 }
 
 template <int D>

@@ -23,8 +23,20 @@ struct WorldSettings {
   ContactMaterial ball_ball;
   ContactMaterial ball_wall;
   bool allow_tension = false;  ///< see LinearSpringDashpot; false is the model of MODEL.md
-  double skin = 0.0;           ///< neighbour-list skin, m; 0 picks the smallest radius
+  /// Neighbour-list skin, m; 0 (the default): chosen at each rebuild (World::choose_skin).
+  double skin = 0.0;
 };
+
+/// With the skin chosen by the World, each neighbour list is made to last about this many
+/// steps at the speed of the fastest particle (the list lasts until some particle has moved
+/// half a skin). A longer-lived list lists more pairs that are not touching, which every step
+/// pays for; a shorter one is rebuilt more often. The optimum is broad: bench/results.md.
+inline constexpr double skin_target_steps = 30.0;
+/// ... and the chosen skin stays between these fractions of the smallest radius: at the
+/// floor, a still charge rebuilds only when something moves; at the ceiling, fast particles
+/// rebuild every few steps rather than list a growing crowd of neighbours.
+inline constexpr double skin_floor = 0.05;
+inline constexpr double skin_ceiling = 1.0;
 
 /// Energy accounts since the world was made, J. The balance
 /// shell_work = Δkinetic + Δpotential + Δstored + dissipated holds to discretisation error.
@@ -73,6 +85,8 @@ class World {
   Walls<D>& walls() { return walls_; }
   const Walls<D>& walls() const { return walls_; }
   const WorldSettings<D>& settings() const { return settings_; }
+  /// The skin of the current neighbour list, m (WorldSettings::skin, or the World's choice).
+  double neighbour_skin() const { return neighbours_.skin(); }
 
   /// Collisions that end from now on are added to `spectrum` (nullptr: not recorded).
   void record_collisions_in(ImpactSpectrum* spectrum) { spectrum_ = spectrum; }
@@ -97,6 +111,9 @@ class World {
  private:
   // The stages of step(), in order.
   void refresh_neighbours();
+  /// The skin for the list about to be built: 2 skin_target_steps Δt |u̇|max, within
+  /// [skin_floor, skin_ceiling] of the smallest radius.
+  double choose_skin() const;
   void estimate_current_velocities();
   void evaluate_pair_contacts();
   void evaluate_wall_contacts();
