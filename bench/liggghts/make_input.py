@@ -133,7 +133,9 @@ def main():
     parser.add_argument("--window", type=int, default=20000,
                         help="power: steps averaged (a multiple of 100)")
     parser.add_argument("--skin", type=float, default=None,
-                        help="neighbour skin, m (default: millsim's, half the ball radius)")
+                        help="neighbour skin, m (default: a quarter of the ball diameter, 5 mm for 20 mm "
+                             "balls; LIGGGHTS ran 3000 steps of the bench in 18.1, 19.4 and 18.5 s "
+                             "at 5, 2 and 1 mm)")
     args = parser.parse_args()
 
     cfg = tomllib.loads(Path(args.config).read_text())

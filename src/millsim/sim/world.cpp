@@ -1,5 +1,7 @@
 #include "millsim/sim/world.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <type_traits>
 
@@ -268,7 +270,17 @@ void World<D>::evaluate_pair_contacts() {
   const double dt = settings_.time_step;
   const std::size_t pairs = first.size();
   const std::size_t blocks = pair_block_ended_.size();
-#pragma omp parallel for schedule(static) if (pairs >= parallel_threshold)
+  // On one thread the pairs add their forces to the particles as they go, in pair order, which
+  // is the order the gather of accumulate_forces() sums them in: the same bits either way.
+  scatter_pair_forces_ = pairs < parallel_threshold || omp_get_max_threads() == 1;
+  const bool scatter = scatter_pair_forces_;
+  auto& force = particles_.force;
+  auto& torque = particles_.torque;
+  if (scatter) {
+    std::fill(force.begin(), force.end(), Vec<D>{});
+    std::fill(torque.begin(), torque.end(), Spin<D>{});
+  }
+#pragma omp parallel for schedule(static) if (!scatter)
   for (std::size_t b = 0; b < blocks; ++b) {
     double dissipated = 0.0;
     std::uint32_t ended = 0;
@@ -298,7 +310,15 @@ void World<D>::evaluate_pair_contacts() {
       history[p].touching = true;
       history[p].overlap = in.overlap;
       const ContactOutput<D> out = ball_ball_law_.evaluate(in, pair_damping_[p], history[p], dt);
-      pair_force_[p] = {out.force, -cross(in.normal, out.tangential_force)};
+      const Spin<D> moment = -cross(in.normal, out.tangential_force);
+      if (scatter) {
+        force[i] -= out.force;
+        torque[i] += r[i] * moment;
+        force[j] += out.force;
+        torque[j] += r[j] * moment;
+      } else {
+        pair_force_[p] = {out.force, moment};
+      }
       dissipated += out.dissipated;
     }
     pair_block_dissipated_[b] = dissipated;
@@ -387,8 +407,10 @@ void World<D>::evaluate_wall_contacts() {
 
 template <int D>
 void World<D>::accumulate_forces() {
-  // Each particle gathers its own forces in a fixed order (walls, pairs where it is first,
-  // pairs where it is second, gravity), so the sums are the same on every run and thread count.
+  // Each particle's forces are summed in a fixed order, so the sums are the same on every run
+  // and thread count: pairs where it is second, pairs where it is first (each in pair order:
+  // as the pair stage meets them, since pairs are sorted by first), then walls, then gravity.
+  // On one thread the pair stage has already summed the pairs into force and torque.
   const auto& first_begin = neighbours_.first_begin();
   const auto& second_begin = neighbours_.second_begin();
   const auto& second_pairs = neighbours_.second_pairs();
@@ -398,21 +420,29 @@ void World<D>::accumulate_forces() {
   const auto& m = particles_.mass;
   const Vec<D> gravity = settings_.gravity;
   const std::size_t count = particles_.size();
+  if (scatter_pair_forces_) {
+#pragma omp parallel for schedule(static) if (count >= parallel_threshold)
+    for (std::size_t i = 0; i < count; ++i) {
+      force[i] = (force[i] + wall_force_[i]) + m[i] * gravity;
+      torque[i] += wall_moment_[i];
+    }
+    return;
+  }
 #pragma omp parallel for schedule(static) if (count >= parallel_threshold)
   for (std::size_t i = 0; i < count; ++i) {
-    Vec<D> f = wall_force_[i];
-    Spin<D> moment = wall_moment_[i];
-    for (std::uint32_t p = first_begin[i]; p < first_begin[i + 1]; ++p) {
-      f -= pair_force_[p].force;
-      moment += r[i] * pair_force_[p].moment;
-    }
+    Vec<D> f{};
+    Spin<D> moment{};
     for (std::uint32_t k = second_begin[i]; k < second_begin[i + 1]; ++k) {
       const std::uint32_t p = second_pairs[k];
       f += pair_force_[p].force;
       moment += r[i] * pair_force_[p].moment;
     }
-    force[i] = f + m[i] * gravity;
-    torque[i] = moment;
+    for (std::uint32_t p = first_begin[i]; p < first_begin[i + 1]; ++p) {
+      f -= pair_force_[p].force;
+      moment += r[i] * pair_force_[p].moment;
+    }
+    force[i] = (f + wall_force_[i]) + m[i] * gravity;
+    torque[i] = moment + wall_moment_[i];
   }
 }
 

@@ -162,7 +162,11 @@ class World {
     Vec<D> force{};
     Spin<D> moment{};
   };
-  std::vector<PairForce> pair_force_;
+  std::vector<PairForce> pair_force_;  // read by the gather only: see scatter_pair_forces_
+  // This step's pair stage ran on one thread and added the pair forces to the particles' force
+  // and torque itself (in the gather's order); else it stored them in pair_force_ for the
+  // gather. Pairs that stop touching zero their pair_force_ either way, so it stays valid.
+  bool scatter_pair_forces_ = false;
   std::vector<ContactDamping> pair_damping_;
   std::vector<EndedCollision> pair_ended_;  // block b's at [b × pair_block, ...)
   std::vector<std::uint32_t> pair_block_ended_;
