@@ -201,10 +201,14 @@ ArrayEstimate estimate_array_bytes(const millsim::World<D>& world) {
   const double pairs = static_cast<double>(list.pair_count());
   constexpr double index = sizeof(std::uint32_t);
   constexpr double store = 3 * sizeof(Vec<D>) + 2 * sizeof(Spin<D>) + 4 * sizeof(double);
-  // u̇(n), ω(n), wall force and moment, wall dashpots, wall-contact slots (id and history).
+  // u̇(n), ω(n), wall force and moment, wall dashpots, the index of its wall-contact slots;
+  // per wall candidate, the slots (id and history) and their rebuild copies.
   constexpr double world_per_particle =
-      2 * sizeof(Vec<D>) + 2 * sizeof(Spin<D>) + sizeof(ContactDamping) +
-      millsim::World<D>::max_wall_contacts * (sizeof(std::int32_t) + sizeof(ContactHistory<D>));
+      2 * sizeof(Vec<D>) + 2 * sizeof(Spin<D>) + sizeof(ContactDamping) + index;
+  constexpr double world_per_candidate =
+      2 * millsim::World<D>::max_wall_contacts * (sizeof(std::int32_t) + sizeof(ContactHistory<D>));
+  const double candidates_per_particle =
+      static_cast<double>(world.wall_candidate_count()) / std::max(1.0, particles);
   // Reference and cell-ordered positions, cell radii, home cells, five index arrays.
   constexpr double search_per_particle =
       2 * sizeof(Vec<D>) + sizeof(double) + sizeof(std::array<long, D>) + 5 * index;
@@ -217,6 +221,7 @@ ArrayEstimate estimate_array_bytes(const millsim::World<D>& world) {
   ArrayEstimate estimate;
   estimate.pairs_per_particle = pairs / std::max(1.0, particles);
   estimate.bytes_per_particle = store + world_per_particle + search_per_particle +
+                                candidates_per_particle * world_per_candidate +
                                 estimate.pairs_per_particle * (world_per_pair + search_per_pair);
   return estimate;
 }

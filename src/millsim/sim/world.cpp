@@ -92,14 +92,12 @@ void World<D>::step() {
 template <int D>
 void World<D>::refresh_neighbours() {
   const std::size_t count = particles_.size();
-  if (wall_slot_id_.size() != count * max_wall_contacts) {
-    wall_slot_id_.assign(count * max_wall_contacts, -1);
-    wall_slot_history_.assign(count * max_wall_contacts, ContactHistory<D>{});
-  }
-  // Particles added since the last step are at the end, each with its index as id.
+  // Particles added since the last step are at the end, each with its index as id and no
+  // wall-contact slots.
   for (std::size_t i = particle_id_.size(); i < count; ++i) {
     particle_id_.push_back(static_cast<std::uint32_t>(i));
     particle_index_.push_back(static_cast<std::uint32_t>(i));
+    wall_slots_of_.push_back(no_wall_slots);
   }
   if (!neighbours_.needs_refresh(particles_.position)) return;
   const double skin = settings_.skin > 0.0 ? settings_.skin : choose_skin();
@@ -128,26 +126,43 @@ void World<D>::refresh_neighbours() {
   pair_block_dissipated_.resize(block_count(pairs, pair_block));
 
   // Wall candidates: a particle further than a skin from every wall cannot reach one before
-  // it has moved half a skin, which triggers the next rebuild. One that leaves the list has
-  // no wall contact left (it is a skin away); any slot it still holds ends here.
+  // it has moved half a skin, which triggers the next rebuild. Each candidate has
+  // max_wall_contacts slots of wall-contact history, carried over from the last list if it was
+  // a candidate then. One that leaves the list has no wall contact left (it is a skin away);
+  // any slot it still held ends here.
+  constexpr auto slots = static_cast<std::size_t>(max_wall_contacts);
   wall_candidates_.clear();
+  next_wall_slot_id_.clear();
+  next_wall_slot_history_.clear();
   wall_force_.assign(count, Vec<D>{});
   wall_moment_.assign(count, Spin<D>{});
   for (std::size_t i = 0; i < count; ++i) {
+    const std::uint32_t held = wall_slots_of_[i];
+    const std::size_t from = static_cast<std::size_t>(held) * slots;
     if (walls_.may_touch(particles_.position[i], particles_.radius[i], skin)) {
+      wall_slots_of_[i] = static_cast<std::uint32_t>(wall_candidates_.size());
       wall_candidates_.push_back(static_cast<std::uint32_t>(i));
+      if (held == no_wall_slots) {
+        next_wall_slot_id_.insert(next_wall_slot_id_.end(), slots, -1);
+        next_wall_slot_history_.insert(next_wall_slot_history_.end(), slots, ContactHistory<D>{});
+      } else {
+        next_wall_slot_id_.insert(next_wall_slot_id_.end(), &wall_slot_id_[from],
+                                  &wall_slot_id_[from] + slots);
+        next_wall_slot_history_.insert(next_wall_slot_history_.end(), &wall_slot_history_[from],
+                                       &wall_slot_history_[from] + slots);
+      }
       continue;
     }
-    for (std::size_t slot = i * max_wall_contacts; slot < (i + 1) * max_wall_contacts; ++slot) {
+    wall_slots_of_[i] = no_wall_slots;
+    if (held == no_wall_slots || spectrum_ == nullptr) continue;
+    for (std::size_t slot = from; slot < from + slots; ++slot) {
       if (wall_slot_id_[slot] < 0) continue;
-      if (spectrum_ != nullptr) {
-        spectrum_->record(wall_contact_type(walls_.kind_of(wall_slot_id_[slot])),
-                          wall_slot_history_[slot].dissipated);
-      }
-      wall_slot_id_[slot] = -1;
-      wall_slot_history_[slot] = ContactHistory<D>{};
+      spectrum_->record(wall_contact_type(walls_.kind_of(wall_slot_id_[slot])),
+                        wall_slot_history_[slot].dissipated);
     }
   }
+  wall_slot_id_.swap(next_wall_slot_id_);
+  wall_slot_history_.swap(next_wall_slot_history_);
   const std::size_t candidates = wall_candidates_.size();
   wall_ended_.resize(candidates * max_wall_contacts);
   wall_block_ended_.resize(block_count(candidates, wall_block));
@@ -179,39 +194,9 @@ void World<D>::reorder_particles(const std::vector<std::uint32_t>& previous) {
     reorder(values, previous, 1, std::get<std::vector<Element>>(reorder_scratch_));
   });
   reorder(particle_id_, previous, 1, std::get<std::vector<std::uint32_t>>(reorder_scratch_));
-  reorder_wall_slots(previous);
+  reorder(wall_slots_of_, previous, 1, std::get<std::vector<std::uint32_t>>(reorder_scratch_));
   for (std::size_t k = 0; k < particle_id_.size(); ++k) {
     particle_index_[particle_id_[k]] = static_cast<std::uint32_t>(k);
-  }
-}
-
-template <int D>
-void World<D>::reorder_wall_slots(const std::vector<std::uint32_t>& previous) {
-  // In place, one cycle of the permutation at a time: slot k takes the slots of previous[k],
-  // whose own are taken next, until the cycle closes on the slots held from its start.
-  const std::size_t count = previous.size();
-  constexpr auto slots = static_cast<std::size_t>(max_wall_contacts);
-  const auto move = [&](std::size_t from, std::size_t to) {
-    std::copy_n(&wall_slot_id_[from * slots], slots, &wall_slot_id_[to * slots]);
-    std::copy_n(&wall_slot_history_[from * slots], slots, &wall_slot_history_[to * slots]);
-  };
-  reorder_moved_.assign(count, 0);
-  for (std::size_t start = 0; start < count; ++start) {
-    if (reorder_moved_[start] != 0) continue;
-    std::array<std::int32_t, slots> held_id;
-    std::array<ContactHistory<D>, slots> held_history;
-    std::copy_n(&wall_slot_id_[start * slots], slots, held_id.begin());
-    std::copy_n(&wall_slot_history_[start * slots], slots, held_history.begin());
-    std::size_t k = start;
-    for (;;) {
-      reorder_moved_[k] = 1;
-      const std::size_t from = previous[k];
-      if (from == start) break;
-      move(from, k);
-      k = from;
-    }
-    std::copy_n(held_id.begin(), slots, &wall_slot_id_[k * slots]);
-    std::copy_n(held_history.begin(), slots, &wall_slot_history_[k * slots]);
   }
 }
 
@@ -344,8 +329,8 @@ void World<D>::evaluate_wall_contacts() {
     const std::size_t end = std::min(candidates, (b + 1) * wall_block);
     for (std::size_t k = b * wall_block; k < end; ++k) {
       const std::size_t i = wall_candidates_[k];
-      std::int32_t* slot_id = &wall_slot_id_[i * max_wall_contacts];
-      ContactHistory<D>* slot_history = &wall_slot_history_[i * max_wall_contacts];
+      std::int32_t* slot_id = &wall_slot_id_[k * max_wall_contacts];
+      ContactHistory<D>* slot_history = &wall_slot_history_[k * max_wall_contacts];
       std::array<bool, max_wall_contacts> seen{};
       Vec<D> force{};
       Spin<D> moment{};

@@ -103,6 +103,8 @@ class World {
   double last_step_dissipation() const { return last_step_dissipation_; }
   long neighbour_rebuilds() const { return neighbours_.rebuild_count(); }
   std::size_t touching_contacts() const;
+  /// Particles that may touch a wall before the next neighbour-list rebuild.
+  std::size_t wall_candidate_count() const { return wall_candidates_.size(); }
 
   double kinetic_energy() const;        ///< translation and rotation, J
   double potential_energy() const;      ///< −Σ m g·x, J
@@ -124,7 +126,6 @@ class World {
   /// Puts every per-particle array in the new order: `previous[k]` is the index before of the
   /// particle that moves to index k.
   void reorder_particles(const std::vector<std::uint32_t>& previous);
-  void reorder_wall_slots(const std::vector<std::uint32_t>& previous);
 
   /// Period of the mill's axis when it is a periodic slab, else 0.
   double axial_period() const;
@@ -178,9 +179,13 @@ class World {
   std::vector<Vec<D>> wall_force_;
   std::vector<Spin<D>> wall_moment_;
   std::vector<ContactDamping> wall_damping_;  // per particle, set at each rebuild
-  // Per particle, max_wall_contacts slots of wall-contact history keyed by wall id.
-  std::vector<std::int32_t> wall_slot_id_;
-  std::vector<ContactHistory<D>> wall_slot_history_;
+  // Per wall candidate (in the order of wall_candidates_), max_wall_contacts slots of
+  // wall-contact history keyed by wall id; per particle, which candidate's slots are its own
+  // (no_wall_slots: none, it is not a candidate); and the arrays the next rebuild fills.
+  static constexpr std::uint32_t no_wall_slots = 0xffffffffU;
+  std::vector<std::int32_t> wall_slot_id_, next_wall_slot_id_;
+  std::vector<ContactHistory<D>> wall_slot_history_, next_wall_slot_history_;
+  std::vector<std::uint32_t> wall_slots_of_;
   std::vector<EndedCollision> wall_ended_;  // block b's at [b × wall_block × max, ...)
   std::vector<std::uint32_t> wall_block_ended_;
   std::vector<double> wall_block_dissipated_, wall_block_torque_, wall_block_work_;
@@ -190,10 +195,9 @@ class World {
   std::vector<std::uint32_t> particle_index_;
   int cell_order_interval_ = 0;
   // Buffers that reorder_particles swaps with the arrays it copies into the new order, one per
-  // element type (Spin<D> is double in 2D and Vec<3> in 3D), and its marks of the wall-contact
-  // slots already moved (those it reorders in place), so that reordering allocates nothing.
+  // element type (Spin<D> is double in 2D and Vec<3> in 3D), so that reordering allocates
+  // nothing.
   std::tuple<std::vector<Vec<D>>, std::vector<double>, std::vector<std::uint32_t>> reorder_scratch_;
-  std::vector<std::uint8_t> reorder_moved_;
 
   double time_ = 0.0;
   long steps_ = 0;
