@@ -102,6 +102,18 @@ void for_each_nearby_lifter(const Mill2D& mill, const Vec2& planar_centre, Visit
   }
 }
 
+/// The lifters to test for a particle at `planar_centre`: `nearby`'s if known, else those of
+/// for_each_nearby_lifter.
+template <typename Visit>
+void for_each_lifter_to_test(const Mill2D& mill, const Vec2& planar_centre,
+                             const NearbyLifters* nearby, Visit&& visit) {
+  if (nearby != nullptr && nearby->count != NearbyLifters::unknown) {
+    for (int k = 0; k < nearby->count; ++k) visit(static_cast<int>(nearby->index[k]));
+    return;
+  }
+  for_each_nearby_lifter(mill, planar_centre, visit);
+}
+
 /// Contact with the shell, a circle (2D) or a cylinder (3D) of radius R about the z axis.
 bool shell_contact(const Mill2D& mill, const Vec2& planar_centre, double particle_radius,
                    WallContact<2>& shell) {
@@ -225,19 +237,53 @@ void Mill2D::turn_to(double new_angle) {
   }
 }
 
+NearbyLifters nearby_lifters(const Mill2D& mill, const Vec2& planar_centre, double reach) {
+  NearbyLifters nearby;
+  const int lifters = mill.lifter_count;
+  // With fewer than five lifters the full search's three may wrap round onto each other.
+  if (lifters < 5) return nearby;
+  if (beyond_lifter_reach(mill, planar_centre, reach)) {
+    nearby.count = 0;
+    return nearby;
+  }
+  // A centre within `reach` of a lifter is at least `closest` from the axis, and within an
+  // angle asin((w/2 + reach) / closest) of the lifter's axis (its offset across the bar is
+  // ρ sin φ, at most w/2 + reach); the nearest lifter by angle is within half a spacing.
+  const double closest = mill.radius - mill.lifter_height - reach;
+  const double across = (0.5 * mill.lifter_width + reach) / closest;
+  if (closest <= 0.0 || across >= 1.0) return nearby;
+  const double spacing = 2.0 * pi / lifters;
+  const int window = static_cast<int>(std::asin(across) / spacing + 0.5) + 1;
+  if (2 * window + 1 >= lifters) return nearby;
+  const double relative = approximate_atan2(planar_centre[1], planar_centre[0]) - mill.angle;
+  const double turns = relative / spacing;
+  const int nearest = static_cast<int>(turns + (turns >= 0.0 ? 0.5 : -0.5));
+  int count = 0;
+  for (int k = nearest - window; k <= nearest + window; ++k) {
+    const int index = ((k % lifters) + lifters) % lifters;
+    WallContact<2> contact;
+    if (!lifter_contact(mill, index, planar_centre, 0.0, reach, contact)) continue;
+    if (count == NearbyLifters::capacity) return NearbyLifters{};
+    nearby.index[static_cast<std::size_t>(count++)] = static_cast<std::int16_t>(index);
+  }
+  nearby.count = static_cast<std::int8_t>(count);
+  return nearby;
+}
+
 int mill_contacts(const Mill2D& mill, const Vec2& centre, double particle_radius,
-                  WallContact<2>* out) {
+                  WallContact<2>* out, const NearbyLifters* nearby) {
   int count = 0;
   if (shell_contact(mill, centre, particle_radius, out[count])) ++count;
+  if (nearby != nullptr && nearby->count == 0) return count;
   if (beyond_lifter_reach(mill, centre, particle_radius)) return count;
-  for_each_nearby_lifter(mill, centre, [&](int index) {
+  for_each_lifter_to_test(mill, centre, nearby, [&](int index) {
     if (lifter_contact(mill, index, centre, 0.0, particle_radius, out[count])) ++count;
   });
   return count;
 }
 
 int mill_contacts(const Mill3D& mill, const Vec3& centre, double particle_radius,
-                  WallContact<3>* out) {
+                  WallContact<3>* out, const NearbyLifters* nearby) {
   int count = 0;
   const Vec2 planar{{centre[0], centre[1]}};
   const double z = centre[2];
@@ -245,12 +291,13 @@ int mill_contacts(const Mill3D& mill, const Vec3& centre, double particle_radius
   if (shell_contact(mill, planar, particle_radius, found) && on_shell_side(mill, planar, z)) {
     out[count++] = extrude(found, z);
   }
-  if (!beyond_lifter_reach(mill, planar, particle_radius)) {
+  if ((nearby == nullptr || nearby->count != 0) &&
+      !beyond_lifter_reach(mill, planar, particle_radius)) {
     // Beyond an end of the bars (only while a sphere presses into an end plate) the closest
     // point is on the bar's end edge or corner, out of the plane of the centre.
     const double bar_z = mill.periodic ? z : std::clamp(z, 0.0, mill.length);
     const double axial = z - bar_z;
-    for_each_nearby_lifter(mill, planar, [&](int index) {
+    for_each_lifter_to_test(mill, planar, nearby, [&](int index) {
       if (!lifter_contact(mill, index, planar, std::abs(axial), particle_radius, found)) return;
       WallContact<3>& contact = out[count++];
       contact = extrude(found, bar_z);

@@ -1,6 +1,7 @@
 // The walls particles touch: a turning mill (shell and lifters) and fixed planes.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -73,6 +74,24 @@ struct Mill3D : Mill2D {
 template <int D>
 using MillShape = std::conditional_t<D == 2, Mill2D, Mill3D>;
 
+/// The lifters a particle may touch for a while, found once so that each step tests those
+/// alone instead of looking up the nearest lifter by angle and testing it and its two
+/// neighbours (World keeps one per wall candidate: see World::refresh_nearby_lifters).
+struct NearbyLifters {
+  static constexpr int capacity = 3;
+  std::array<std::int16_t, capacity> index{};  ///< in the order the full search visits them
+  /// How many of `index` are in use; `unknown` when they were not found (too few lifters,
+  /// too many within reach, or never looked up): the step then searches as usual.
+  std::int8_t count = unknown;
+  static constexpr std::int8_t unknown = -1;
+};
+
+/// The lifters within `reach` of a centre (distance from the centre to the bar < reach), or
+/// NearbyLifters::unknown. Every lifter a particle of radius r can touch while it stays within
+/// d of `planar_centre` and the mill turns its lifters by at most s (arc length at the shell)
+/// is among those within r + d + s. In mill_geometry.cpp.
+NearbyLifters nearby_lifters(const Mill2D& mill, const Vec2& planar_centre, double reach);
+
 /// An infinite plane (a line in 2D): the particle side is where (x − point)·normal > 0.
 template <int D>
 struct Plane {
@@ -100,21 +119,25 @@ struct Walls {
   /// False when no wall can come within `margin` of the particle, however the mill turns: it
   /// then needs no wall search until it has moved `margin` (the contact search's skin).
   bool may_touch(const Vec<D>& centre, double particle_radius, double margin) const;
-  /// Calls emit(const WallContact<D>&) for every wall the particle overlaps.
+  /// Calls emit(const WallContact<D>&) for every wall the particle overlaps. With `nearby`
+  /// known, only those lifters are tested (see NearbyLifters); the contacts and their order
+  /// are the same.
   template <typename Emit>
-  void for_each_contact(const Vec<D>& centre, double particle_radius, Emit&& emit) const;
+  void for_each_contact(const Vec<D>& centre, double particle_radius, Emit&& emit,
+                        const NearbyLifters* nearby = nullptr) const;
 };
 
 /// Closest-feature contact of a disc with the mill; in mill_geometry.cpp.
-/// Writes at most 4 contacts (shell and up to three lifters) and returns how many.
+/// Writes at most 4 contacts (shell and up to three lifters) and returns how many. With
+/// `nearby` known (nearby_lifters() of a centre near enough), only those lifters are tested.
 int mill_contacts(const Mill2D& mill, const Vec2& centre, double particle_radius,
-                  WallContact<2>* out);
+                  WallContact<2>* out, const NearbyLifters* nearby = nullptr);
 /// The same for a sphere in a 3D mill: the shell, up to three lifters (rectangular prisms,
 /// touched on a face, an edge or a corner, whichever is closest) and the walls of the end it
 /// is at (a flat plate, or a cone and its trunnion plate). Writes at most 6 contacts and
-/// returns how many.
+/// returns how many. `nearby` as in 2D.
 int mill_contacts(const Mill3D& mill, const Vec3& centre, double particle_radius,
-                  WallContact<3>* out);
+                  WallContact<3>* out, const NearbyLifters* nearby = nullptr);
 /// Most wall contacts one particle can have with a mill (a 3D mill is at least one ball
 /// diameter long, so a ball touches the walls of one end at most).
 template <int D>
@@ -139,11 +162,12 @@ bool Walls<D>::may_touch(const Vec<D>& centre, double particle_radius, double ma
 
 template <int D>
 template <typename Emit>
-void Walls<D>::for_each_contact(const Vec<D>& centre, double particle_radius, Emit&& emit) const {
+void Walls<D>::for_each_contact(const Vec<D>& centre, double particle_radius, Emit&& emit,
+                                const NearbyLifters* nearby) const {
   int id_offset = 0;
   if (mill) {
     WallContact<D> found[max_mill_contacts<D>];
-    const int count = mill_contacts(*mill, centre, particle_radius, found);
+    const int count = mill_contacts(*mill, centre, particle_radius, found, nearby);
     for (int k = 0; k < count; ++k) emit(found[k]);
     id_offset = mill_wall_count();
   }

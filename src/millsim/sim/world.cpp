@@ -99,7 +99,10 @@ void World<D>::refresh_neighbours() {
     particle_index_.push_back(static_cast<std::uint32_t>(i));
     wall_slots_of_.push_back(no_wall_slots);
   }
-  if (!neighbours_.needs_refresh(particles_.position)) return;
+  if (!neighbours_.needs_refresh(particles_.position)) {
+    if (lifters_moved_too_far()) refresh_nearby_lifters();
+    return;
+  }
   const double skin = settings_.skin > 0.0 ? settings_.skin : choose_skin();
   neighbours_.set_skin(skin);
   const bool into_cell_order =
@@ -169,6 +172,50 @@ void World<D>::refresh_neighbours() {
   wall_block_dissipated_.resize(block_count(candidates, wall_block));
   wall_block_torque_.resize(block_count(candidates, wall_block));
   wall_block_work_.resize(block_count(candidates, wall_block));
+  refresh_nearby_lifters();
+}
+
+template <int D>
+bool World<D>::lifters_moved_too_far() const {
+  if (!walls_.mill || nearby_lifters_.size() != wall_candidates_.size()) {
+    return nearby_lifter_lists_ && walls_.mill.has_value();
+  }
+  const auto& mill = *walls_.mill;
+  return mill.lifter_count != nearby_lifter_count_ ||
+         std::abs(mill.angle - nearby_lifter_angle_) * mill.radius > lifter_travel_;
+}
+
+template <int D>
+void World<D>::refresh_nearby_lifters() {
+  // A candidate moves at most half a skin from where it was at the last rebuild before the
+  // next one, so at most a skin from where it is now. The lifters move with the mill; the
+  // lists are made again when they have moved lifter_travel_ (here the smallest radius, which
+  // on the mills measured is tens to hundreds of steps of turning: seldom before the next
+  // rebuild). A lifter the candidate can touch before then is within r + skin + travel now.
+  const std::size_t candidates = wall_candidates_.size();
+  if (!walls_.mill || !nearby_lifter_lists_) {
+    nearby_lifters_.clear();
+    return;
+  }
+  const auto& mill = *walls_.mill;
+  const double skin = neighbours_.skin();
+  lifter_travel_ = 0.0;
+  if (particles_.size() > 0) {
+    lifter_travel_ = *std::min_element(particles_.radius.begin(), particles_.radius.end());
+  }
+  nearby_lifter_angle_ = mill.angle;
+  nearby_lifter_count_ = mill.lifter_count;
+  ++nearby_lifter_refreshes_;
+  nearby_lifters_.resize(candidates);
+  // The reach is widened by a part in a million for the rounding of the distances.
+  constexpr double rounding = 1.0 + 1e-6;
+#pragma omp parallel for schedule(static) if (candidates >= parallel_threshold)
+  for (std::size_t k = 0; k < candidates; ++k) {
+    const std::size_t i = wall_candidates_[k];
+    const Vec<D>& x = particles_.position[i];
+    const double reach = rounding * (particles_.radius[i] + skin + lifter_travel_);
+    nearby_lifters_[k] = nearby_lifters(mill, Vec2{{x[0], x[1]}}, reach);
+  }
 }
 
 template <int D>
@@ -335,35 +382,39 @@ void World<D>::evaluate_wall_contacts() {
       Vec<D> force{};
       Spin<D> moment{};
       const double radius = particles_.radius[i];
-      walls_.for_each_contact(particles_.position[i], radius, [&](const WallContact<D>& contact) {
-        int slot = 0;
-        while (slot < max_wall_contacts && slot_id[slot] != contact.wall_id) ++slot;
-        if (slot == max_wall_contacts) {
-          slot = 0;
-          while (slot < max_wall_contacts && slot_id[slot] >= 0) ++slot;
-          if (slot == max_wall_contacts) return;  // cannot happen: see max_wall_contacts
-          slot_id[slot] = contact.wall_id;
-        }
-        seen[static_cast<std::size_t>(slot)] = true;
-        ContactInput<D> in;
-        in.normal = contact.normal;
-        in.overlap = contact.overlap;
-        in.velocity = velocity_now_[i] - contact.wall_velocity;
-        in.spin_velocity = cross(contact.normal, radius * spin_now_[i]);
-        in.step_velocity = particles_.velocity[i] - contact.wall_velocity;
-        in.step_spin_velocity = cross(contact.normal, radius * particles_.angular_velocity[i]);
-        ContactHistory<D>& history = slot_history[slot];
-        history.touching = true;
-        history.overlap = contact.overlap;
-        const ContactOutput<D> out = ball_wall_law_.evaluate(in, wall_damping_[i], history, dt);
-        force += out.force;
-        moment += -radius * cross(contact.normal, out.tangential_force);
-        dissipated += out.dissipated;
-        if (contact.kind != WallKind::plane) {
-          torque += axial_moment(contact.point, out.force);
-          work += dot(out.force, contact.wall_velocity) * dt;
-        }
-      });
+      const NearbyLifters* nearby = nearby_lifters_.empty() ? nullptr : &nearby_lifters_[k];
+      walls_.for_each_contact(
+          particles_.position[i], radius,
+          [&](const WallContact<D>& contact) {
+            int slot = 0;
+            while (slot < max_wall_contacts && slot_id[slot] != contact.wall_id) ++slot;
+            if (slot == max_wall_contacts) {
+              slot = 0;
+              while (slot < max_wall_contacts && slot_id[slot] >= 0) ++slot;
+              if (slot == max_wall_contacts) return;  // cannot happen: see max_wall_contacts
+              slot_id[slot] = contact.wall_id;
+            }
+            seen[static_cast<std::size_t>(slot)] = true;
+            ContactInput<D> in;
+            in.normal = contact.normal;
+            in.overlap = contact.overlap;
+            in.velocity = velocity_now_[i] - contact.wall_velocity;
+            in.spin_velocity = cross(contact.normal, radius * spin_now_[i]);
+            in.step_velocity = particles_.velocity[i] - contact.wall_velocity;
+            in.step_spin_velocity = cross(contact.normal, radius * particles_.angular_velocity[i]);
+            ContactHistory<D>& history = slot_history[slot];
+            history.touching = true;
+            history.overlap = contact.overlap;
+            const ContactOutput<D> out = ball_wall_law_.evaluate(in, wall_damping_[i], history, dt);
+            force += out.force;
+            moment += -radius * cross(contact.normal, out.tangential_force);
+            dissipated += out.dissipated;
+            if (contact.kind != WallKind::plane) {
+              torque += axial_moment(contact.point, out.force);
+              work += dot(out.force, contact.wall_velocity) * dt;
+            }
+          },
+          nearby);
       for (int slot = 0; slot < max_wall_contacts; ++slot) {
         if (slot_id[slot] < 0 || seen[static_cast<std::size_t>(slot)]) continue;
         block_ended[ended++] = {wall_contact_type(walls_.kind_of(slot_id[slot])),

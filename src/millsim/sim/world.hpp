@@ -82,6 +82,17 @@ class World {
   /// particles near each other in space from nearby memory (0, the default: never). The
   /// physics is the same; only the order of sums changes, and with it the last bits.
   void set_cell_order_interval(int rebuilds) { cell_order_interval_ = rebuilds; }
+  /// Whether each wall candidate keeps the list of lifters it may touch (on by default; see
+  /// refresh_nearby_lifters). Off, every step finds them from the candidate's angle. The
+  /// contacts, and so the results, are the same bit for bit either way; tests switch it off
+  /// to show that.
+  void set_nearby_lifter_lists(bool on) {
+    nearby_lifter_lists_ = on;
+    nearby_lifters_.clear();
+  }
+  /// How often the lists of nearby lifters were made, at rebuilds and because the mill had
+  /// turned too far since.
+  long nearby_lifter_refreshes() const { return nearby_lifter_refreshes_; }
   Walls<D>& walls() { return walls_; }
   const Walls<D>& walls() const { return walls_; }
   const WorldSettings<D>& settings() const { return settings_; }
@@ -118,6 +129,8 @@ class World {
   double choose_skin() const;
   void estimate_current_velocities();
   void evaluate_pair_contacts();
+  void refresh_nearby_lifters();
+  bool lifters_moved_too_far() const;
   void evaluate_wall_contacts();
   void accumulate_forces();
   void integrate();
@@ -186,6 +199,15 @@ class World {
   std::vector<std::int32_t> wall_slot_id_, next_wall_slot_id_;
   std::vector<ContactHistory<D>> wall_slot_history_, next_wall_slot_history_;
   std::vector<std::uint32_t> wall_slots_of_;
+  // Per wall candidate, the lifters it may touch until the next rebuild or until the lifters
+  // have moved lifter_travel_ (arc length at the shell) since they were listed, at mill angle
+  // nearby_lifter_angle_ (refresh_nearby_lifters).
+  bool nearby_lifter_lists_ = true;
+  std::vector<NearbyLifters> nearby_lifters_;
+  double nearby_lifter_angle_ = 0.0;
+  double lifter_travel_ = 0.0;
+  int nearby_lifter_count_ = 0;
+  long nearby_lifter_refreshes_ = 0;
   std::vector<EndedCollision> wall_ended_;  // block b's at [b × wall_block × max, ...)
   std::vector<std::uint32_t> wall_block_ended_;
   std::vector<double> wall_block_dissipated_, wall_block_torque_, wall_block_work_;
