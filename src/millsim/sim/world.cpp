@@ -82,8 +82,7 @@ void World<D>::step() {
   estimate_current_velocities();
   evaluate_pair_contacts();
   evaluate_wall_contacts();
-  accumulate_forces();
-  integrate();
+  accumulate_forces_and_integrate();
   advance_walls();
   time_ += settings_.time_step;
   ++steps_;
@@ -303,7 +302,8 @@ void World<D>::evaluate_pair_contacts() {
   const std::size_t pairs = first.size();
   const std::size_t blocks = pair_block_ended_.size();
   // On one thread the pairs add their forces to the particles as they go, in pair order, which
-  // is the order the gather of accumulate_forces() sums them in: the same bits either way.
+  // is the order the gather of accumulate_forces_and_integrate() sums them in: the same bits either
+  // way.
   scatter_pair_forces_ = pairs < parallel_threshold || omp_get_max_threads() == 1;
   const bool scatter = scatter_pair_forces_;
   auto& force = particles_.force;
@@ -442,57 +442,54 @@ void World<D>::evaluate_wall_contacts() {
 }
 
 template <int D>
-void World<D>::accumulate_forces() {
+void World<D>::accumulate_forces_and_integrate() {
   // Each particle's forces are summed in a fixed order, so the sums are the same on every run
   // and thread count: pairs where it is second, pairs where it is first (each in pair order:
   // as the pair stage meets them, since pairs are sorted by first), then walls, then gravity.
-  // On one thread the pair stage has already summed the pairs into force and torque.
+  // On one thread the pair stage has already summed the pairs into force and torque. Then the
+  // particle is advanced, in the same pass (one read of its arrays instead of two):
+  // leapfrog u̇(n+½) = u̇(n−½) + ü(n) Δt, u(n+1) = u(n) + u̇(n+½) Δt; the same for rotation.
   const auto& first_begin = neighbours_.first_begin();
   const auto& second_begin = neighbours_.second_begin();
   const auto& second_pairs = neighbours_.second_pairs();
-  auto& force = particles_.force;
-  auto& torque = particles_.torque;
-  const auto& r = particles_.radius;
-  const auto& m = particles_.mass;
+  auto& p = particles_;
+  auto& force = p.force;
+  auto& torque = p.torque;
+  const auto& r = p.radius;
+  const auto& m = p.mass;
   const Vec<D> gravity = settings_.gravity;
-  const std::size_t count = particles_.size();
+  const double dt = settings_.time_step;
+  const std::size_t count = p.size();
+  const auto advance = [&](std::size_t i) {
+    p.velocity[i] += (p.inverse_mass[i] * dt) * force[i];
+    p.position[i] += dt * p.velocity[i];
+    p.angular_velocity[i] += (p.inverse_inertia[i] * dt) * torque[i];
+  };
   if (scatter_pair_forces_) {
 #pragma omp parallel for schedule(static) if (count >= parallel_threshold)
     for (std::size_t i = 0; i < count; ++i) {
       force[i] = (force[i] + wall_force_[i]) + m[i] * gravity;
       torque[i] += wall_moment_[i];
+      advance(i);
     }
-    return;
-  }
+  } else {
 #pragma omp parallel for schedule(static) if (count >= parallel_threshold)
-  for (std::size_t i = 0; i < count; ++i) {
-    Vec<D> f{};
-    Spin<D> moment{};
-    for (std::uint32_t k = second_begin[i]; k < second_begin[i + 1]; ++k) {
-      const std::uint32_t p = second_pairs[k];
-      f += pair_force_[p].force;
-      moment += r[i] * pair_force_[p].moment;
+    for (std::size_t i = 0; i < count; ++i) {
+      Vec<D> f{};
+      Spin<D> moment{};
+      for (std::uint32_t k = second_begin[i]; k < second_begin[i + 1]; ++k) {
+        const std::uint32_t q = second_pairs[k];
+        f += pair_force_[q].force;
+        moment += r[i] * pair_force_[q].moment;
+      }
+      for (std::uint32_t q = first_begin[i]; q < first_begin[i + 1]; ++q) {
+        f -= pair_force_[q].force;
+        moment += r[i] * pair_force_[q].moment;
+      }
+      force[i] = (f + wall_force_[i]) + m[i] * gravity;
+      torque[i] = moment + wall_moment_[i];
+      advance(i);
     }
-    for (std::uint32_t p = first_begin[i]; p < first_begin[i + 1]; ++p) {
-      f -= pair_force_[p].force;
-      moment += r[i] * pair_force_[p].moment;
-    }
-    force[i] = (f + wall_force_[i]) + m[i] * gravity;
-    torque[i] = moment + wall_moment_[i];
-  }
-}
-
-template <int D>
-void World<D>::integrate() {
-  // Leapfrog: u̇(n+½) = u̇(n−½) + ü(n) Δt, u(n+1) = u(n) + u̇(n+½) Δt; the same for rotation.
-  const double dt = settings_.time_step;
-  auto& p = particles_;
-  const std::size_t count = p.size();
-#pragma omp parallel for schedule(static) if (count >= parallel_threshold)
-  for (std::size_t i = 0; i < count; ++i) {
-    p.velocity[i] += (p.inverse_mass[i] * dt) * p.force[i];
-    p.position[i] += dt * p.velocity[i];
-    p.angular_velocity[i] += (p.inverse_inertia[i] * dt) * p.torque[i];
   }
   const double period = neighbours_.period();
   if (period > 0.0) {

@@ -132,8 +132,7 @@ class World {
   void refresh_nearby_lifters();
   bool lifters_moved_too_far() const;
   void evaluate_wall_contacts();
-  void accumulate_forces();
-  void integrate();
+  void accumulate_forces_and_integrate();
   void advance_walls();
 
   /// Puts every per-particle array in the new order: `previous[k]` is the index before of the
