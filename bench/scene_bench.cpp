@@ -209,15 +209,16 @@ ArrayEstimate estimate_array_bytes(const millsim::World<D>& world) {
       2 * millsim::World<D>::max_wall_contacts * (sizeof(std::int32_t) + sizeof(ContactHistory<D>));
   const double candidates_per_particle =
       static_cast<double>(world.wall_candidate_count()) / std::max(1.0, particles);
-  // Reference and cell-ordered positions, cell radii, home cells, five index arrays.
+  // Reference and cell-ordered positions, cell radii, home cells, four index arrays.
   constexpr double search_per_particle =
-      2 * sizeof(Vec<D>) + sizeof(double) + sizeof(std::array<long, D>) + 5 * index;
-  // Force and moment, dashpots, an ended-collision slot (type and energy).
-  constexpr double world_per_pair =
-      sizeof(Vec<D>) + sizeof(Spin<D>) + sizeof(ContactDamping) + 2 * sizeof(double);
-  // first, second and their rebuild copies, the by-second index, the search's found pair,
-  // the history and its rebuild copy.
-  constexpr double search_per_pair = 5 * index + 2 * index + 2 * sizeof(ContactHistory<D>);
+      2 * sizeof(Vec<D>) + sizeof(double) + sizeof(std::array<long, D>) + 4 * index;
+  // Dashpots, an ended-collision slot (type and energy); on several threads also this step's
+  // status and energy.
+  const double world_per_pair = sizeof(ContactDamping) + 2 * sizeof(double) +
+                                (omp_get_max_threads() > 1 ? 1.0 + sizeof(double) : 0.0);
+  // first, second and their rebuild copies, the search's found pair, the history and its
+  // rebuild copy.
+  constexpr double search_per_pair = 4 * index + 2 * index + 2 * sizeof(ContactHistory<D>);
   ArrayEstimate estimate;
   estimate.pairs_per_particle = pairs / std::max(1.0, particles);
   estimate.bytes_per_particle = store + world_per_particle + search_per_particle +

@@ -1,6 +1,6 @@
-// Deterministic by construction (STYLE.md rule 5): the same scene stepped on one thread and on
-// two gives bitwise-identical particles, energy accounts and collision spectra. The stages of
-// World::step() go parallel only above 2048 items (particles, neighbour pairs, wall
+// Deterministic by construction (STYLE.md rule 5): the same scene stepped on one thread, on
+// two and on three gives bitwise-identical particles, energy accounts and collision spectra. The
+// stages of World::step() go parallel only above 2048 items (particles, neighbour pairs, wall
 // candidates; `parallel_threshold` in sim/world.cpp), so the scenes are big enough for every
 // parallel path to run, and the test checks that they are. The particles are renumbered in
 // cell order at every neighbour-list rebuild (the mill job does it less often), during the
@@ -44,6 +44,7 @@ template <int D>
 struct Outcome {
   World<D> world;
   ImpactSpectrum spectrum;
+  int threads = 1;
 };
 
 /// The plan's world with its charge set in motion: every particle moving at up to `speed`
@@ -93,7 +94,7 @@ Outcome<D> step_on(const World<D>& scene, int steps, int threads) {
     team = omp_get_num_threads();
   }
   EXPECT_EQ(team, threads) << "OpenMP did not give the team asked for";
-  Outcome<D> outcome{scene, ImpactSpectrum{}};
+  Outcome<D> outcome{scene, ImpactSpectrum{}, threads};
   outcome.world.record_collisions_in(&outcome.spectrum);
   for (int n = 0; n < steps; ++n) outcome.world.step();
   outcome.world.record_collisions_in(nullptr);
@@ -159,7 +160,7 @@ void expect_identical(const Outcome<D>& one, const Outcome<D>& two) {
                       a.angular_velocity[i] == b.angular_velocity[i] && a.force[i] == b.force[i] &&
                       a.torque[i] == b.torque[i];
     if (!same && differing++ < 5) {
-      ADD_FAILURE() << "particle " << i << " differs between 1 and 2 threads";
+      ADD_FAILURE() << "particle " << i << " differs between 1 and " << two.threads << " threads";
     }
   }
   EXPECT_EQ(differing, 0u) << "particles that differ";
@@ -186,20 +187,26 @@ void expect_identical(const Outcome<D>& one, const Outcome<D>& two) {
   }
 }
 
-TEST(Determinism, SagMill2DIsTheSameOnOneAndTwoThreads) {
+TEST(Determinism, SagMill2DIsTheSameOnOneTwoAndThreeThreads) {
   // The 2D SAG benchmark scene (bench/sag-12m-2d.toml): a 12 m mill with forty lifters and
   // about 7 000 discs of 25–150 mm, Δt = 4.5e-5 s, the shell turning at 5 rpm. The charge is
   // placed over the whole mill (30 % filling, so a fifth of its area). The discs within 5.5 m
   // of the axis are drawn in by 0.7 (those beyond, among the 0.2 m lifters from 5.8 m out,
   // stay), all are set moving at up to 3 m/s, and after 200 steps there are thousands of close
-  // pairs and hundreds of contacts, some with the shell and lifters. From there, 80 steps on
-  // one thread and on two.
+  // pairs and hundreds of contacts, some with the shell and lifters. From there, 400 steps on
+  // one thread, on two and on three (enough for a change in the order of one particle's pair
+  // forces to show: with the forces of pairs across two threads' particles added last, the
+  // particles differ after 400 steps but not yet after 80).
   const MillPlan plan = plan_mill(load_mill_config(
       std::string(MILLSIM_SOURCE_DIR) + "/bench/sag-12m-2d.toml", {"output.snapshot_interval=0"}));
   const World<2> scene = moving_scene<2>(plan, 5.5, 0.7, 3.0, 200);
-  const Outcome<2> one = step_on(scene, 80, 1);
-  const Outcome<2> two = step_on(scene, 80, 2);
+  const Outcome<2> one = step_on(scene, 400, 1);
+  const Outcome<2> two = step_on(scene, 400, 2);
   expect_identical(one, two);
+  // Three threads split the particles and pairs three ways (more threads than this machine's
+  // cores is fine: only the order of the sums is at stake).
+  const Outcome<2> three = step_on(scene, 400, 3);
+  expect_identical(one, three);
 
   // The parallel paths ran: particles and listed pairs above the threshold (the wall stage's
   // candidates, the discs near the shell, stay below it here; the 3D scene covers it), and the
@@ -269,14 +276,16 @@ snapshot_interval = 0
 }
 
 void expect_3d_scene_deterministic(bool periodic) {
-  // Set moving at up to 4 m/s, 200 steps on one thread (2.3 ms), then 100 more on one and on
-  // two threads.
+  // Set moving at up to 4 m/s, 200 steps on one thread (2.3 ms), then 400 more on one, two and
+  // three threads.
   const MillPlan plan =
       plan_mill(parse_mill_config(short_wide_mill(periodic), "short-wide-mill.toml"));
   const World<3> scene = moving_scene<3>(plan, 0.0, 1.0, 4.0, 200);
-  const Outcome<3> one = step_on(scene, 100, 1);
-  const Outcome<3> two = step_on(scene, 100, 2);
+  const Outcome<3> one = step_on(scene, 400, 1);
+  const Outcome<3> two = step_on(scene, 400, 2);
   expect_identical(one, two);
+  const Outcome<3> three = step_on(scene, 400, 3);
+  expect_identical(one, three);
 
   const World<3>& world = one.world;
   EXPECT_GT(world.particles().size(), parallel_threshold);
@@ -292,11 +301,11 @@ void expect_3d_scene_deterministic(bool periodic) {
   }
 }
 
-TEST(Determinism, ShortWideMill3DIsTheSameOnOneAndTwoThreads) {
+TEST(Determinism, ShortWideMill3DIsTheSameOnOneTwoAndThreeThreads) {
   expect_3d_scene_deterministic(false);
 }
 
-TEST(Determinism, PeriodicSlab3DIsTheSameOnOneAndTwoThreads) {
+TEST(Determinism, PeriodicSlab3DIsTheSameOnOneTwoAndThreeThreads) {
   expect_3d_scene_deterministic(true);
 }
 

@@ -230,22 +230,11 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
     reference_position_ = position;
   }
 
-  // Per-particle views of the pair list (counting sorts; pairs are already ordered by first).
+  // Where each particle's pairs as the first begin (a counting sort; pairs are already ordered
+  // by first).
   first_begin_.assign(count + 1, 0);
-  second_begin_.assign(count + 1, 0);
-  for (std::size_t p = 0; p < first_.size(); ++p) {
-    ++first_begin_[first_[p] + 1];
-    ++second_begin_[second_[p] + 1];
-  }
-  for (std::size_t i = 0; i < count; ++i) {
-    first_begin_[i + 1] += first_begin_[i];
-    second_begin_[i + 1] += second_begin_[i];
-  }
-  second_pairs_.resize(first_.size());
-  cell_cursor_.assign(second_begin_.begin(), second_begin_.end() - 1);
-  for (std::size_t p = 0; p < first_.size(); ++p) {
-    second_pairs_[cell_cursor_[second_[p]]++] = static_cast<std::uint32_t>(p);
-  }
+  for (std::size_t p = 0; p < first_.size(); ++p) ++first_begin_[first_[p] + 1];
+  for (std::size_t i = 0; i < count; ++i) first_begin_[i + 1] += first_begin_[i];
 }
 
 template class NeighbourList<2>;

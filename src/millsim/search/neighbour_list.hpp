@@ -57,11 +57,6 @@ class NeighbourList {
   const std::vector<ContactHistory<D>>& history() const { return history_; }
   /// Pairs of particle i as the first: [first_begin()[i], first_begin()[i + 1]).
   const std::vector<std::uint32_t>& first_begin() const { return first_begin_; }
-  /// Pairs of particle i as the second: second_pairs()[second_begin()[i] .. second_begin()[i+1]),
-  /// in increasing pair order. With first_begin(), a particle can gather the forces of all its
-  /// pairs itself, in a fixed order, whatever thread does it.
-  const std::vector<std::uint32_t>& second_begin() const { return second_begin_; }
-  const std::vector<std::uint32_t>& second_pairs() const { return second_pairs_; }
   long rebuild_count() const { return rebuild_count_; }
   /// The skin the current list was built with, m.
   double skin() const { return skin_; }
@@ -73,7 +68,7 @@ class NeighbourList {
   long rebuild_count_ = 0;
   std::vector<std::uint32_t> first_, second_;
   std::vector<ContactHistory<D>> history_;
-  std::vector<std::uint32_t> first_begin_, second_begin_, second_pairs_;
+  std::vector<std::uint32_t> first_begin_;
   std::vector<Vec<D>> reference_position_;
   // Scratch kept between rebuilds so that a rebuild allocates nothing in steady state.
   std::vector<std::uint32_t> particle_cell_, cell_start_, cell_cursor_, cell_members_;

@@ -108,10 +108,7 @@ void World<D>::refresh_neighbours() {
       cell_order_interval_ > 0 && neighbours_.rebuild_count() % cell_order_interval_ == 0;
   neighbours_.rebuild(particles_.position, particles_.radius, into_cell_order);
   if (into_cell_order) reorder_particles(neighbours_.previous_index());
-  // Pair forces start at zero and return to zero when a contact ends, so that a pair that is
-  // not touching costs no store (evaluate_pair_contacts).
   const std::size_t pairs = neighbours_.pair_count();
-  pair_force_.assign(pairs, PairForce{});
   pair_damping_.resize(pairs);
   const auto& first = neighbours_.first();
   const auto& second = neighbours_.second();
@@ -288,6 +285,52 @@ void World<D>::record_ended(const std::vector<EndedCollision>& ended,
 }
 
 template <int D>
+void World<D>::split_pairs_among(int threads) {
+  // Thread t owns the particles [split_particle_[t], split_particle_[t + 1]) and the pairs whose
+  // first particle is one of them, a run of the list (sorted by first) of about the same cost.
+  const auto& first_begin = neighbours_.first_begin();
+  const auto& second = neighbours_.second();
+  const std::size_t count = particles_.size();
+  const std::size_t pairs = second.size();
+  const auto ranges = static_cast<std::size_t>(threads);
+  // Weighed by their cost: a pair that touches (the contact law) costs about four times one
+  // that does not (a distance test), as the list was made.
+  const auto& history = neighbours_.history();
+  constexpr std::size_t touching_weight = 4;
+  std::size_t total = 0;
+  for (std::size_t q = 0; q < pairs; ++q) total += history[q].touching ? touching_weight : 1;
+  split_particle_.assign(ranges + 1, static_cast<std::uint32_t>(count));
+  split_pair_.assign(ranges + 1, static_cast<std::uint32_t>(pairs));
+  split_particle_[0] = 0;
+  split_pair_[0] = 0;
+  std::size_t t = 1;
+  std::size_t weight = 0;
+  for (std::size_t i = 0; i < count && t < ranges; ++i) {
+    // Particle i starts range t once the ranges before it hold t / ranges of the weight.
+    while (t < ranges && weight * ranges >= t * total) {
+      split_particle_[t] = static_cast<std::uint32_t>(i);
+      split_pair_[t] = first_begin[i];
+      ++t;
+    }
+    for (std::uint32_t q = first_begin[i]; q < first_begin[i + 1]; ++q) {
+      weight += history[q].touching ? touching_weight : 1;
+    }
+  }
+  // Pairs whose second particle belongs to a later thread than their first (pairs are stored
+  // with first < second, so never an earlier one).
+  cross_pairs_.clear();
+  for (std::size_t range = 0; range < ranges; ++range) {
+    for (std::size_t q = split_pair_[range]; q < split_pair_[range + 1]; ++q) {
+      if (second[q] >= split_particle_[range + 1])
+        cross_pairs_.push_back(static_cast<std::uint32_t>(q));
+    }
+  }
+  cross_force_.resize(cross_pairs_.size());
+  split_threads_ = threads;
+  split_rebuild_ = neighbours_.rebuild_count();
+}
+
+template <int D>
 void World<D>::evaluate_pair_contacts() {
   const auto& first = neighbours_.first();
   const auto& second = neighbours_.second();
@@ -301,60 +344,154 @@ void World<D>::evaluate_pair_contacts() {
   const double dt = settings_.time_step;
   const std::size_t pairs = first.size();
   const std::size_t blocks = pair_block_ended_.size();
-  // On one thread the pairs add their forces to the particles as they go, in pair order, which
-  // is the order the gather of accumulate_forces_and_integrate() sums them in: the same bits either
-  // way.
-  scatter_pair_forces_ = pairs < parallel_threshold || omp_get_max_threads() == 1;
-  const bool scatter = scatter_pair_forces_;
   auto& force = particles_.force;
   auto& torque = particles_.torque;
-  if (scatter) {
+
+  // Pair q: its contact this step. Writes the force on the second particle and the moment both
+  // receive (scaled by their radii) to `out` if the pair touches, and returns what happened.
+  const auto evaluate = [&](std::size_t q, PairForce & out) __attribute__((always_inline))
+                            ->PairOutcome {
+    const std::uint32_t i = first[q];
+    const std::uint32_t j = second[q];
+    const Vec<D> offset = neighbours_.separation(x[i], x[j]);
+    const double distance_squared = norm_squared(offset);
+    const double reach = r[i] + r[j];
+    if (distance_squared >= reach * reach) {
+      if (!history[q].touching) return {PairStatus::apart, 0.0};
+      const double energy = history[q].dissipated;
+      history[q] = ContactHistory<D>{};
+      return {PairStatus::ended, energy};
+    }
+    const double distance = std::sqrt(distance_squared);
+    ContactInput<D> in;
+    in.normal = offset * (1.0 / distance);
+    in.overlap = reach - distance;
+    in.velocity = v[j] - v[i];
+    in.spin_velocity = cross(in.normal, r[i] * w[i] + r[j] * w[j]);
+    in.step_velocity = step_v[j] - step_v[i];
+    in.step_spin_velocity = cross(in.normal, r[i] * step_w[i] + r[j] * step_w[j]);
+    history[q].touching = true;
+    history[q].overlap = in.overlap;
+    const ContactOutput<D> result = ball_ball_law_.evaluate(in, pair_damping_[q], history[q], dt);
+    out = {result.force, -cross(in.normal, result.tangential_force)};
+    return {PairStatus::touching, result.dissipated};
+  };
+  // Adds a touching pair's force and moment to its particles: −F on the first, +F on the
+  // second.
+  const auto add_to_first = [&](std::size_t q, const PairForce& f) {
+    const std::uint32_t i = first[q];
+    force[i] -= f.force;
+    torque[i] += r[i] * f.moment;
+  };
+  const auto add_to_second = [&](std::size_t q, const PairForce& f) {
+    const std::uint32_t j = second[q];
+    force[j] += f.force;
+    torque[j] += r[j] * f.moment;
+  };
+
+  // Each particle sums its pairs in pair order (pairs where it is second come first, as their
+  // first particle has the lower index): the order in which one thread going down the list
+  // meets them. On one thread the pairs add their forces to the particles as they go.
+  if (pairs < parallel_threshold || omp_get_max_threads() == 1) {
     std::fill(force.begin(), force.end(), Vec<D>{});
     std::fill(torque.begin(), torque.end(), Spin<D>{});
-  }
-#pragma omp parallel for schedule(static) if (!scatter)
-  for (std::size_t b = 0; b < blocks; ++b) {
-    double dissipated = 0.0;
-    std::uint32_t ended = 0;
-    const std::size_t end = std::min(pairs, (b + 1) * pair_block);
-    for (std::size_t p = b * pair_block; p < end; ++p) {
-      const std::uint32_t i = first[p];
-      const std::uint32_t j = second[p];
-      const Vec<D> offset = neighbours_.separation(x[i], x[j]);
-      const double distance_squared = norm_squared(offset);
-      const double reach = r[i] + r[j];
-      if (distance_squared >= reach * reach) {
-        if (history[p].touching) {
-          pair_ended_[b * pair_block + ended++] = {ContactType::ball_ball, history[p].dissipated};
-          history[p] = ContactHistory<D>{};
-          pair_force_[p] = PairForce{};
+    for (std::size_t b = 0; b < blocks; ++b) {
+      double dissipated = 0.0;
+      std::uint32_t ended = 0;
+      const std::size_t end = std::min(pairs, (b + 1) * pair_block);
+      for (std::size_t q = b * pair_block; q < end; ++q) {
+        PairForce f;
+        const PairOutcome outcome = evaluate(q, f);
+        if (outcome.status == PairStatus::ended) {
+          pair_ended_[b * pair_block + ended++] = {ContactType::ball_ball, outcome.energy};
+        } else if (outcome.status == PairStatus::touching) {
+          add_to_first(q, f);
+          add_to_second(q, f);
+          dissipated += outcome.energy;
         }
-        continue;
       }
-      const double distance = std::sqrt(distance_squared);
-      ContactInput<D> in;
-      in.normal = offset * (1.0 / distance);
-      in.overlap = reach - distance;
-      in.velocity = v[j] - v[i];
-      in.spin_velocity = cross(in.normal, r[i] * w[i] + r[j] * w[j]);
-      in.step_velocity = step_v[j] - step_v[i];
-      in.step_spin_velocity = cross(in.normal, r[i] * step_w[i] + r[j] * step_w[j]);
-      history[p].touching = true;
-      history[p].overlap = in.overlap;
-      const ContactOutput<D> out = ball_ball_law_.evaluate(in, pair_damping_[p], history[p], dt);
-      const Spin<D> moment = -cross(in.normal, out.tangential_force);
-      if (scatter) {
-        force[i] -= out.force;
-        torque[i] += r[i] * moment;
-        force[j] += out.force;
-        torque[j] += r[j] * moment;
-      } else {
-        pair_force_[p] = {out.force, moment};
-      }
-      dissipated += out.dissipated;
+      pair_block_dissipated_[b] = dissipated;
+      pair_block_ended_[b] = ended;
     }
-    pair_block_dissipated_[b] = dissipated;
-    pair_block_ended_[b] = ended;
+  } else {
+    // Several threads give the same sums in the same order. Thread t owns a run of particles
+    // and the pairs whose first particle is one of them (split_pairs_among). A pair whose second
+    // particle belongs to a later thread (a cross pair, about 1 % of them with cell ordering) is
+    // evaluated first, before a barrier; then each thread zeroes its particles, adds the cross
+    // pairs' forces to their second particles (they come before any of its own pairs in pair
+    // order), and goes down its own pairs, adding each one's force to both particles, or, for a
+    // cross pair, the stored force to the first. Each pair's dissipation and end are kept
+    // apart and summed afterwards in the fixed blocks of the one-thread path.
+    const int threads = omp_get_max_threads();
+    if (threads != split_threads_ || neighbours_.rebuild_count() != split_rebuild_ ||
+        split_pair_.back() != pairs) {
+      split_pairs_among(threads);
+    }
+    pair_status_.resize(pairs);
+    pair_energy_.resize(pairs);
+    const std::size_t crossing = cross_pairs_.size();
+    const auto ranges = static_cast<std::size_t>(split_threads_);
+#pragma omp parallel num_threads(split_threads_)
+    {
+#pragma omp for schedule(static)
+      for (std::size_t c = 0; c < crossing; ++c) {
+        const std::uint32_t q = cross_pairs_[c];
+        const PairOutcome outcome = evaluate(q, cross_force_[c]);
+        pair_status_[q] = outcome.status;
+        pair_energy_[q] = outcome.energy;
+      }
+      // The implicit barrier of the loop above: every cross pair's force is known.
+      const auto team = static_cast<std::size_t>(omp_get_num_threads());
+      for (auto t = static_cast<std::size_t>(omp_get_thread_num()); t < ranges; t += team) {
+        const std::uint32_t own_begin = split_particle_[t];
+        const std::uint32_t own_end = split_particle_[t + 1];
+        for (std::uint32_t i = own_begin; i < own_end; ++i) {
+          force[i] = Vec<D>{};
+          torque[i] = Spin<D>{};
+        }
+        for (std::size_t c = 0; c < crossing; ++c) {
+          const std::uint32_t q = cross_pairs_[c];
+          const std::uint32_t j = second[q];
+          if (j >= own_begin && j < own_end && pair_status_[q] == PairStatus::touching) {
+            add_to_second(q, cross_force_[c]);
+          }
+        }
+        std::size_t c = static_cast<std::size_t>(
+            std::lower_bound(cross_pairs_.begin(), cross_pairs_.end(), split_pair_[t]) -
+            cross_pairs_.begin());
+        for (std::size_t q = split_pair_[t]; q < split_pair_[t + 1]; ++q) {
+          if (second[q] >= own_end) {
+            if (pair_status_[q] == PairStatus::touching) add_to_first(q, cross_force_[c]);
+            ++c;
+            continue;
+          }
+          PairForce f;
+          const PairOutcome outcome = evaluate(q, f);
+          pair_status_[q] = outcome.status;
+          pair_energy_[q] = outcome.energy;
+          if (outcome.status == PairStatus::touching) {
+            add_to_first(q, f);
+            add_to_second(q, f);
+          }
+        }
+      }
+#pragma omp barrier
+#pragma omp for schedule(static)
+      for (std::size_t b = 0; b < blocks; ++b) {
+        double dissipated = 0.0;
+        std::uint32_t ended = 0;
+        const std::size_t end = std::min(pairs, (b + 1) * pair_block);
+        for (std::size_t q = b * pair_block; q < end; ++q) {
+          if (pair_status_[q] == PairStatus::touching) {
+            dissipated += pair_energy_[q];
+          } else if (pair_status_[q] == PairStatus::ended) {
+            pair_ended_[b * pair_block + ended++] = {ContactType::ball_ball, pair_energy_[q]};
+          }
+        }
+        pair_block_dissipated_[b] = dissipated;
+        pair_block_ended_[b] = ended;
+      }
+    }
   }
   last_step_dissipation_ = 0.0;
   for (const double d : pair_block_dissipated_) last_step_dissipation_ += d;
@@ -444,52 +581,24 @@ void World<D>::evaluate_wall_contacts() {
 template <int D>
 void World<D>::accumulate_forces_and_integrate() {
   // Each particle's forces are summed in a fixed order, so the sums are the same on every run
-  // and thread count: pairs where it is second, pairs where it is first (each in pair order:
-  // as the pair stage meets them, since pairs are sorted by first), then walls, then gravity.
-  // On one thread the pair stage has already summed the pairs into force and torque. Then the
-  // particle is advanced, in the same pass (one read of its arrays instead of two):
-  // leapfrog u̇(n+½) = u̇(n−½) + ü(n) Δt, u(n+1) = u(n) + u̇(n+½) Δt; the same for rotation.
-  const auto& first_begin = neighbours_.first_begin();
-  const auto& second_begin = neighbours_.second_begin();
-  const auto& second_pairs = neighbours_.second_pairs();
+  // and thread count: its pairs in pair order (the pair stage has added them into force and
+  // torque), then walls, then gravity. Then the particle is advanced, in the same pass (one
+  // read of its arrays instead of two): leapfrog u̇(n+½) = u̇(n−½) + ü(n) Δt,
+  // u(n+1) = u(n) + u̇(n+½) Δt; the same for rotation.
   auto& p = particles_;
   auto& force = p.force;
   auto& torque = p.torque;
-  const auto& r = p.radius;
   const auto& m = p.mass;
   const Vec<D> gravity = settings_.gravity;
   const double dt = settings_.time_step;
   const std::size_t count = p.size();
-  const auto advance = [&](std::size_t i) {
+#pragma omp parallel for schedule(static) if (count >= parallel_threshold)
+  for (std::size_t i = 0; i < count; ++i) {
+    force[i] = (force[i] + wall_force_[i]) + m[i] * gravity;
+    torque[i] += wall_moment_[i];
     p.velocity[i] += (p.inverse_mass[i] * dt) * force[i];
     p.position[i] += dt * p.velocity[i];
     p.angular_velocity[i] += (p.inverse_inertia[i] * dt) * torque[i];
-  };
-  if (scatter_pair_forces_) {
-#pragma omp parallel for schedule(static) if (count >= parallel_threshold)
-    for (std::size_t i = 0; i < count; ++i) {
-      force[i] = (force[i] + wall_force_[i]) + m[i] * gravity;
-      torque[i] += wall_moment_[i];
-      advance(i);
-    }
-  } else {
-#pragma omp parallel for schedule(static) if (count >= parallel_threshold)
-    for (std::size_t i = 0; i < count; ++i) {
-      Vec<D> f{};
-      Spin<D> moment{};
-      for (std::uint32_t k = second_begin[i]; k < second_begin[i + 1]; ++k) {
-        const std::uint32_t q = second_pairs[k];
-        f += pair_force_[q].force;
-        moment += r[i] * pair_force_[q].moment;
-      }
-      for (std::uint32_t q = first_begin[i]; q < first_begin[i + 1]; ++q) {
-        f -= pair_force_[q].force;
-        moment += r[i] * pair_force_[q].moment;
-      }
-      force[i] = (f + wall_force_[i]) + m[i] * gravity;
-      torque[i] = moment + wall_moment_[i];
-      advance(i);
-    }
   }
   const double period = neighbours_.period();
   if (period > 0.0) {

@@ -129,6 +129,7 @@ class World {
   double choose_skin() const;
   void estimate_current_velocities();
   void evaluate_pair_contacts();
+  void split_pairs_among(int threads);
   void refresh_nearby_lifters();
   bool lifters_moved_too_far() const;
   void evaluate_wall_contacts();
@@ -166,20 +167,32 @@ class World {
   std::vector<Vec<D>> velocity_now_;
   std::vector<Spin<D>> spin_now_;
 
-  // Work is split in blocks of a fixed size; each block keeps its own sums and ended
-  // collisions, added up in block order, so results do not depend on the number of threads.
-  // Per pair of the neighbour list: force on the second particle and the moment per unit
-  // radius, −n × F_t, that both particles receive (scaled by their radii), side by side for
-  // the gather; and the pair's dashpot coefficients, set at each rebuild.
+  // A pair's contact in one step: the force on the second particle and the moment per unit
+  // radius, −n × F_t, that both particles receive (scaled by their radii).
   struct PairForce {
     Vec<D> force{};
     Spin<D> moment{};
   };
-  std::vector<PairForce> pair_force_;  // read by the gather only: see scatter_pair_forces_
-  // This step's pair stage ran on one thread and added the pair forces to the particles' force
-  // and torque itself (in the gather's order); else it stored them in pair_force_ for the
-  // gather. Pairs that stop touching zero their pair_force_ either way, so it stays valid.
-  bool scatter_pair_forces_ = false;
+  // What happened to a pair in this step, and its energy: dissipated if touching, the
+  // collision's total if it ended.
+  enum class PairStatus : std::uint8_t { apart, touching, ended };
+  struct PairOutcome {
+    PairStatus status;
+    double energy;
+  };
+  // Several threads (evaluate_pair_contacts): per thread, the first of its particles and of
+  // its pairs (and one past the last, at the end), for split_threads_ threads and the list of
+  // rebuild split_rebuild_; the cross pairs, in pair order, and their forces this step; and per
+  // pair this step's status and energy, summed into the blocks afterwards.
+  std::vector<std::uint32_t> split_particle_{0}, split_pair_{0};
+  int split_threads_ = 0;
+  long split_rebuild_ = -1;
+  std::vector<std::uint32_t> cross_pairs_;
+  std::vector<PairForce> cross_force_;
+  std::vector<PairStatus> pair_status_;
+  std::vector<double> pair_energy_;
+  // Work is split in blocks of a fixed size; each block keeps its own sums and ended
+  // collisions, added up in block order, so results do not depend on the number of threads.
   std::vector<ContactDamping> pair_damping_;
   std::vector<EndedCollision> pair_ended_;  // block b's at [b × pair_block, ...)
   std::vector<std::uint32_t> pair_block_ended_;
