@@ -2,7 +2,11 @@
 # Runs the paper's headline 2D scene (bench/sag-12m-2d.toml: 12 m SAG mill, ~7 200 discs,
 # 2 s of settling + two revolutions at 5 rpm = 24 s of turning) and prints the wall time, the
 # real-time factor and particle-steps per second. Record results in bench/results.md.
-#   bench/run_sag_benchmark.sh [THREADS] [OUTPUT_DIRECTORY]     (default: 1 thread)
+#   bench/run_sag_benchmark.sh [THREADS] [OUTPUT_DIRECTORY] [--set KEY=VALUE ...]
+# (default: 1 thread; --set as for `millsim run`). Issue 5's target 1 fixes the time step at
+# 1/15 of the smallest ball-ball contact (`millsim info bench/sag-12m-2d.toml` gives it:
+# 0.0008989 s):
+#   bench/run_sag_benchmark.sh 2 runs/bench/sag-12m-2d-t15 --set simulation.time_step=5.993e-5
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -10,8 +14,9 @@ cmake --preset release >/dev/null
 cmake --build --preset release --target millsim >/dev/null
 threads=${1:-1}
 out=${2:-runs/bench/sag-12m-2d}
+shift $(( $# < 2 ? $# : 2 ))
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'), $threads thread(s)"
-./build/release/millsim run -q -j "$threads" bench/sag-12m-2d.toml --out "$out"
+./build/release/millsim run -q -j "$threads" bench/sag-12m-2d.toml --out "$out" "$@"
 # Real-time factor: simulated mill seconds (settling included) per wall second.
 awk -F'[:,]' '/"simulated_seconds"/ {s = $2} /"wall_seconds"/ {w = $2}
   END {printf "simulated %.2f s in %.1f s of wall time: real-time factor %.3f\n", s, w, s / w}' \
