@@ -416,12 +416,12 @@ void World<D>::evaluate_pair_contacts() {
   } else {
     // Several threads give the same sums in the same order. Thread t owns a run of particles
     // and the pairs whose first particle is one of them (split_pairs_among). A pair whose second
-    // particle belongs to a later thread (a cross pair, about 1 % of them with cell ordering) is
-    // evaluated first, before a barrier; then each thread zeroes its particles, adds the cross
-    // pairs' forces to their second particles (they come before any of its own pairs in pair
-    // order), and goes down its own pairs, adding each one's force to both particles, or, for a
-    // cross pair, the stored force to the first. Each pair's dissipation and end are kept
-    // apart and summed afterwards in the fixed blocks of the one-thread path.
+    // particle belongs to a later thread (a cross pair: 1.5 % of the 3D 20 k scene's on two
+    // threads) is evaluated first, before a barrier; then each thread zeroes its particles, adds
+    // the cross pairs' forces to their second particles (they come before any of its own pairs in
+    // pair order), and goes down its own pairs, adding each one's force to both particles, or, for
+    // a cross pair, the stored force to the first. Each pair's dissipation and end are kept apart
+    // and summed afterwards in the fixed blocks of the one-thread path.
     const int threads = omp_get_max_threads();
     if (threads != split_threads_ || neighbours_.rebuild_count() != split_rebuild_ ||
         split_pair_.back() != pairs) {
