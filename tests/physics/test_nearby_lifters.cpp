@@ -16,6 +16,7 @@
 #include "millsim/io/config.hpp"
 #include "millsim/sim/charge.hpp"
 #include "millsim/sim/world.hpp"
+#include "support/turning_world.hpp"
 
 namespace millsim {
 namespace {
@@ -96,31 +97,11 @@ TEST(NearbyLifters, UnknownWhenTheFullSearchMustDecide) {
 World<2> turning_example_2d(bool lists, double speed_factor, double skin, int steps) {
   const MillPlan plan = plan_mill(
       parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", {"output.snapshot_interval=0"}));
-  const World<2> built = build_mill_world<2>(plan);
-  WorldSettings<2> settings = built.settings();
-  settings.skin = skin;
-  World<2> world(settings, built.walls());
-  world.particles() = built.particles();
-  world.walls().mill->angular_speed = speed_factor * plan.angular_speed;
+  World<2> world =
+      testing::turning_copy(build_mill_world<2>(plan), speed_factor * plan.angular_speed, skin);
   world.set_nearby_lifter_lists(lists);
   for (int n = 0; n < steps; ++n) world.step();
   return world;
-}
-
-/// Every particle's position, velocity and spin compared with ==; returns how many differ.
-template <int D>
-std::size_t differing_particles(const World<D>& a, const World<D>& b) {
-  const auto& p = a.particles();
-  const auto& q = b.particles();
-  if (p.size() != q.size()) return p.size() + q.size();
-  std::size_t differing = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    differing += p.position[i] == q.position[i] && p.velocity[i] == q.velocity[i] &&
-                         p.angular_velocity[i] == q.angular_velocity[i]
-                     ? 0
-                     : 1;
-  }
-  return differing;
 }
 
 TEST(NearbyLifters, TheSameMotionToTheLastBitIn2D) {
@@ -135,7 +116,7 @@ TEST(NearbyLifters, TheSameMotionToTheLastBitIn2D) {
           "speed x" + std::to_string(speed_factor) + ", skin " + std::to_string(skin);
       const World<2> listed = turning_example_2d(true, speed_factor, skin, 5000);
       const World<2> searched = turning_example_2d(false, speed_factor, skin, 5000);
-      EXPECT_EQ(differing_particles(listed, searched), 0u) << what;
+      EXPECT_EQ(testing::differing_particles(listed, searched), 0u) << what;
       EXPECT_EQ(listed.energy_account().shell_work, searched.energy_account().shell_work) << what;
       EXPECT_EQ(listed.touching_contacts(), searched.touching_contacts()) << what;
       // The lists were in use, and with the wide skin also remade between rebuilds.
@@ -155,12 +136,8 @@ World<3> turning_3d(bool lists, double speed_factor, double skin, int steps) {
   const MillPlan plan =
       plan_mill(load_mill_config(std::string(MILLSIM_SOURCE_DIR) + "/examples/validation/3D-g.toml",
                                  {"output.snapshot_interval=0"}));
-  const World<3> built = build_mill_world<3>(plan);
-  WorldSettings<3> settings = built.settings();
-  settings.skin = skin;
-  World<3> world(settings, built.walls());
-  world.particles() = built.particles();
-  world.walls().mill->angular_speed = speed_factor * plan.angular_speed;
+  World<3> world =
+      testing::turning_copy(build_mill_world<3>(plan), speed_factor * plan.angular_speed, skin);
   world.set_nearby_lifter_lists(lists);
   for (int n = 0; n < steps; ++n) world.step();
   return world;
@@ -170,7 +147,7 @@ TEST(NearbyLifters, TheSameMotionToTheLastBitIn3D) {
   for (const double skin : {0.0, 0.0762}) {
     const World<3> listed = turning_3d(true, 3.0, skin, 3000);
     const World<3> searched = turning_3d(false, 3.0, skin, 3000);
-    EXPECT_EQ(differing_particles(listed, searched), 0u) << "skin " << skin;
+    EXPECT_EQ(testing::differing_particles(listed, searched), 0u) << "skin " << skin;
     EXPECT_EQ(listed.energy_account().shell_work, searched.energy_account().shell_work);
     EXPECT_GE(listed.nearby_lifter_refreshes(), listed.neighbour_rebuilds());
     if (skin > 0.0) {

@@ -12,6 +12,7 @@
 #include "millsim/io/config.hpp"
 #include "millsim/sim/charge.hpp"
 #include "millsim/sim/world.hpp"
+#include "support/turning_world.hpp"
 
 namespace millsim {
 namespace {
@@ -54,12 +55,7 @@ TEST(NeighbourSkin, AFixedSkinIsKept) {
 World<2> turning_example(double skin, int steps) {
   const MillPlan plan = plan_mill(
       parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", {"output.snapshot_interval=0"}));
-  const World<2> built = build_mill_world<2>(plan);
-  WorldSettings<2> settings = built.settings();
-  settings.skin = skin;
-  World<2> world(settings, built.walls());
-  world.particles() = built.particles();
-  world.walls().mill->angular_speed = plan.angular_speed;
+  World<2> world = testing::turning_copy(build_mill_world<2>(plan), plan.angular_speed, skin);
   for (int n = 0; n < steps; ++n) world.step();
   return world;
 }
@@ -78,16 +74,8 @@ TEST(NeighbourSkin, AnySkinGivesTheSameMotionToTheLastBit) {
   for (const World<2>* other : {&one_radius, &three_radii}) {
     ASSERT_NE(other->neighbour_rebuilds(), chosen.neighbour_rebuilds())
         << "the skins should have rebuilt the list at different times";
-    const auto& a = chosen.particles();
-    const auto& b = other->particles();
-    ASSERT_EQ(a.size(), b.size());
-    std::size_t differing = 0;
-    for (std::size_t i = 0; i < a.size(); ++i) {
-      differing += a.position[i] == b.position[i] && a.velocity[i] == b.velocity[i] &&
-                           a.angular_velocity[i] == b.angular_velocity[i]
-                       ? 0
-                       : 1;
-    }
+    ASSERT_EQ(chosen.particles().size(), other->particles().size());
+    const std::size_t differing = testing::differing_particles(chosen, *other);
     EXPECT_EQ(differing, 0u) << "skin " << other->neighbour_skin() << " m";
     EXPECT_EQ(chosen.touching_contacts(), other->touching_contacts());
   }
