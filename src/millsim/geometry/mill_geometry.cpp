@@ -250,8 +250,9 @@ NearbyLifters nearby_lifters(const Mill2D& mill, const Vec2& planar_centre, doub
   // angle asin((w/2 + reach) / closest) of the lifter's axis (its offset across the bar is
   // ρ sin φ, at most w/2 + reach); the nearest lifter by angle is within half a spacing.
   const double closest = mill.radius - mill.lifter_height - reach;
+  if (closest <= 0.0) return nearby;
   const double across = (0.5 * mill.lifter_width + reach) / closest;
-  if (closest <= 0.0 || across >= 1.0) return nearby;
+  if (across >= 1.0) return nearby;
   const double spacing = 2.0 * pi / lifters;
   const int window = static_cast<int>(std::asin(across) / spacing + 0.5) + 1;
   if (2 * window + 1 >= lifters) return nearby;
