@@ -18,10 +18,20 @@ template <int D>
 bool NeighbourList<D>::needs_refresh(const std::vector<Vec<D>>& position) const {
   if (position.size() != reference_position_.size()) return true;
   const double limit = 0.25 * skin_ * skin_;  // (skin / 2)²
-  for (std::size_t i = 0; i < position.size(); ++i) {
-    if (norm_squared(separation(reference_position_[i], position[i])) > limit) return true;
+  const std::size_t count = position.size();
+  if (count < parallel_search_threshold) {
+    for (std::size_t i = 0; i < count; ++i) {
+      if (norm_squared(separation(reference_position_[i], position[i])) > limit) return true;
+    }
+    return false;
   }
-  return false;
+  // Every step asks: on several threads, each looks at its share of the particles through.
+  bool moved = false;
+#pragma omp parallel for schedule(static) reduction(|| : moved)
+  for (std::size_t i = 0; i < count; ++i) {
+    moved = moved || norm_squared(separation(reference_position_[i], position[i])) > limit;
+  }
+  return moved;
 }
 
 template <int D>
@@ -194,11 +204,11 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
         next_second_[slot] = b;
       }
     }
-    std::uint32_t begin = 0;
+    // pair_cursor_[i] is now the end of particle i's pairs, and the start of particle i + 1's.
+#pragma omp parallel for schedule(static) if (count >= parallel_search_threshold)
     for (std::size_t i = 0; i < count; ++i) {
-      const std::uint32_t end = pair_cursor_[i];
-      std::sort(next_second_.begin() + begin, next_second_.begin() + end);
-      begin = end;
+      const std::uint32_t begin = i == 0 ? 0 : pair_cursor_[i - 1];
+      std::sort(next_second_.begin() + begin, next_second_.begin() + pair_cursor_[i]);
     }
   }
   // Carry the history of pairs kept from the old list, found among the old pairs of the lower
@@ -207,7 +217,9 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
   // quantities of the history are the same for both bodies).
   next_history_.assign(next_first_.size(), ContactHistory<D>{});
   const std::size_t old_count = first_begin_.empty() ? 0 : first_begin_.size() - 1;
-  for (std::size_t p = 0; p < next_first_.size(); ++p) {
+  const std::size_t pairs = next_first_.size();
+#pragma omp parallel for schedule(static) if (pairs >= parallel_search_threshold)
+  for (std::size_t p = 0; p < pairs; ++p) {
     std::uint32_t a = into_cell_order ? previous_index_[next_first_[p]] : next_first_[p];
     std::uint32_t b = into_cell_order ? previous_index_[next_second_[p]] : next_second_[p];
     const bool swapped = a > b;

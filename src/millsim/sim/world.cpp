@@ -27,6 +27,10 @@ constexpr std::size_t pair_block = 1024;
 constexpr std::size_t wall_block = 256;
 /// Below this many items a stage runs on one thread (a parallel region costs microseconds).
 constexpr std::size_t parallel_threshold = 2048;
+/// The same for the wall stage, whose candidates cost tens of pairs each: from two blocks on
+/// (the 2D SAG scene has about a thousand candidates; on one thread they held the other one
+/// waiting for 3 % of the step).
+constexpr std::size_t parallel_wall_threshold = 2 * wall_block;
 
 std::size_t block_count(std::size_t items, std::size_t block) {
   return (items + block - 1) / block;
@@ -113,6 +117,7 @@ void World<D>::refresh_neighbours() {
   const auto& first = neighbours_.first();
   const auto& second = neighbours_.second();
   const auto& m = particles_.mass;
+#pragma omp parallel for schedule(static) if (pairs >= parallel_threshold)
   for (std::size_t p = 0; p < pairs; ++p) {
     const std::uint32_t i = first[p];
     const std::uint32_t j = second[p];
@@ -258,17 +263,47 @@ ParticleStore<D> World<D>::particles_by_id() const {
 }
 
 template <int D>
+bool World<D>::pairs_split_among_threads() {
+  const int threads = omp_get_max_threads();
+  const std::size_t pairs = neighbours_.pair_count();
+  if (pairs < parallel_threshold || threads == 1) return false;
+  if (threads != split_threads_ || neighbours_.rebuild_count() != split_rebuild_ ||
+      split_pair_.back() != pairs) {
+    split_pairs_among(threads);
+  }
+  return true;
+}
+
+template <int D>
+template <class Body>
+void World<D>::for_each_particle(Body&& body) {
+  const std::size_t count = particles_.size();
+  if (pairs_split_among_threads()) {
+    const auto ranges = static_cast<std::size_t>(split_threads_);
+#pragma omp parallel num_threads(split_threads_)
+    {
+      const auto team = static_cast<std::size_t>(omp_get_num_threads());
+      for (auto t = static_cast<std::size_t>(omp_get_thread_num()); t < ranges; t += team) {
+        for (std::size_t i = split_particle_[t]; i < split_particle_[t + 1]; ++i) body(i);
+      }
+    }
+    return;
+  }
+#pragma omp parallel for schedule(static) if (count >= parallel_threshold)
+  for (std::size_t i = 0; i < count; ++i) body(i);
+}
+
+template <int D>
 void World<D>::estimate_current_velocities() {
   const std::size_t count = particles_.size();
   velocity_now_.resize(count);
   spin_now_.resize(count);
   const double half_step = 0.5 * settings_.time_step;
   const auto& p = particles_;
-#pragma omp parallel for schedule(static) if (count >= parallel_threshold)
-  for (std::size_t i = 0; i < count; ++i) {
+  for_each_particle([&](std::size_t i) {
     velocity_now_[i] = p.velocity[i] + (half_step * p.inverse_mass[i]) * p.force[i];
     spin_now_[i] = p.angular_velocity[i] + (half_step * p.inverse_inertia[i]) * p.torque[i];
-  }
+  });
 }
 
 template <int D>
@@ -392,7 +427,7 @@ void World<D>::evaluate_pair_contacts() {
   // Each particle sums its pairs in pair order (pairs where it is second come first, as their
   // first particle has the lower index): the order in which one thread going down the list
   // meets them. On one thread the pairs add their forces to the particles as they go.
-  if (pairs < parallel_threshold || omp_get_max_threads() == 1) {
+  if (!pairs_split_among_threads()) {
     std::fill(force.begin(), force.end(), Vec<D>{});
     std::fill(torque.begin(), torque.end(), Spin<D>{});
     for (std::size_t b = 0; b < blocks; ++b) {
@@ -422,11 +457,7 @@ void World<D>::evaluate_pair_contacts() {
     // pair order), and goes down its own pairs, adding each one's force to both particles, or, for
     // a cross pair, the stored force to the first. Each pair's dissipation and end are kept apart
     // and summed afterwards in the fixed blocks of the one-thread path.
-    const int threads = omp_get_max_threads();
-    if (threads != split_threads_ || neighbours_.rebuild_count() != split_rebuild_ ||
-        split_pair_.back() != pairs) {
-      split_pairs_among(threads);
-    }
+    pairs_split_among_threads();
     pair_status_.resize(pairs);
     pair_energy_.resize(pairs);
     const std::size_t crossing = cross_pairs_.size();
@@ -503,7 +534,9 @@ void World<D>::evaluate_wall_contacts() {
   const double dt = settings_.time_step;
   const std::size_t candidates = wall_candidates_.size();
   const std::size_t blocks = wall_block_ended_.size();
-#pragma omp parallel for schedule(static) if (candidates >= parallel_threshold)
+  // Blocks differ in cost (a block of candidates along the lifters' faces costs more than one
+  // on the bare shell): handed out as threads come free.
+#pragma omp parallel for schedule(dynamic) if (candidates >= parallel_wall_threshold)
   for (std::size_t b = 0; b < blocks; ++b) {
     double torque = 0.0;
     double work = 0.0;
@@ -592,14 +625,13 @@ void World<D>::accumulate_forces_and_integrate() {
   const Vec<D> gravity = settings_.gravity;
   const double dt = settings_.time_step;
   const std::size_t count = p.size();
-#pragma omp parallel for schedule(static) if (count >= parallel_threshold)
-  for (std::size_t i = 0; i < count; ++i) {
+  for_each_particle([&](std::size_t i) {
     force[i] = (force[i] + wall_force_[i]) + m[i] * gravity;
     torque[i] += wall_moment_[i];
     p.velocity[i] += (p.inverse_mass[i] * dt) * force[i];
     p.position[i] += dt * p.velocity[i];
     p.angular_velocity[i] += (p.inverse_inertia[i] * dt) * torque[i];
-  }
+  });
   const double period = neighbours_.period();
   if (period > 0.0) {
     // Keep positions in [0, period) along the periodic axis.

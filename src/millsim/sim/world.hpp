@@ -130,6 +130,14 @@ class World {
   void estimate_current_velocities();
   void evaluate_pair_contacts();
   void split_pairs_among(int threads);
+  /// Whether the pair stage runs on several threads; if so, makes sure its split of particles
+  /// and pairs among them (split_pairs_among) is that of the current list and thread count.
+  bool pairs_split_among_threads();
+  /// body(i) for every particle: on several threads each its own run of particles of the pair
+  /// stage (so that a thread's particles stay in its core's cache from stage to stage), else
+  /// on one thread, or split evenly if there are many particles but few pairs.
+  template <class Body>
+  void for_each_particle(Body&& body);
   void refresh_nearby_lifters();
   bool lifters_moved_too_far() const;
   void evaluate_wall_contacts();
