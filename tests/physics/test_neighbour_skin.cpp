@@ -33,7 +33,7 @@ World<2> two_discs_after_one_step(double speed, double fixed_skin = 0.0) {
 }
 
 TEST(NeighbourSkin, ChosenToLastTheTargetStepsAtTheFastestParticlesSpeed) {
-  // 2 × 30 steps × 1e-5 s × 5 m/s = 3 mm, between 0.05 and 1 of the smallest radius (1 cm).
+  // 2 × 30 steps × 1e-5 s × 5 m/s = 3 mm, between 0.05 and 3 of the smallest radius (1 cm).
   const World<2> world = two_discs_after_one_step(5.0);
   EXPECT_DOUBLE_EQ(world.neighbour_skin(), 2.0 * skin_target_steps * time_step * 5.0);
   EXPECT_DOUBLE_EQ(world.neighbour_skin(), 0.003);
@@ -41,8 +41,21 @@ TEST(NeighbourSkin, ChosenToLastTheTargetStepsAtTheFastestParticlesSpeed) {
 
 TEST(NeighbourSkin, StillParticlesGetTheFloorAndFastOnesTheCeiling) {
   EXPECT_DOUBLE_EQ(two_discs_after_one_step(0.0).neighbour_skin(), skin_floor * radius);
-  // 2 × 30 × 1e-5 s × 100 m/s = 6 cm would exceed the smallest radius: capped at it.
-  EXPECT_DOUBLE_EQ(two_discs_after_one_step(100.0).neighbour_skin(), skin_ceiling * radius);
+  // 2 × 30 × 1e-5 s × 100 m/s = 6 cm would exceed three times the smallest radius (1 cm):
+  // capped there.
+  EXPECT_DOUBLE_EQ(two_discs_after_one_step(100.0).neighbour_skin(), skin_ceiling<2> * radius);
+}
+
+TEST(NeighbourSkin, TheCeilingIsThreeRadiiIn2DAndOneIn3D) {
+  // The same fast particle (6 cm of skin wanted) in 3D is capped at one smallest radius.
+  WorldSettings<3> settings;
+  settings.time_step = time_step;
+  World<3> world(settings, Walls<3>{});
+  world.particles().add(Vec3{{0.0, 0.0, 0.0}}, radius, 0.1);
+  world.particles().add(Vec3{{1.0, 0.0, 0.0}}, 2.0 * radius, 0.8, Vec3{{0.0, 100.0, 0.0}});
+  world.step();
+  EXPECT_DOUBLE_EQ(world.neighbour_skin(), 1.0 * radius);
+  EXPECT_DOUBLE_EQ(two_discs_after_one_step(100.0).neighbour_skin(), 3.0 * radius);
 }
 
 TEST(NeighbourSkin, AFixedSkinIsKept) {
@@ -84,7 +97,7 @@ TEST(NeighbourSkin, AnySkinGivesTheSameMotionToTheLastBit) {
   EXPECT_GT(chosen.energy_account().shell_work, 0.0);
   // The chosen skin is the rule's, for the speeds at the last rebuild: within its bounds.
   EXPECT_GE(chosen.neighbour_skin(), skin_floor * smallest);
-  EXPECT_LE(chosen.neighbour_skin(), skin_ceiling * smallest);
+  EXPECT_LE(chosen.neighbour_skin(), skin_ceiling<2> * smallest);
 }
 
 }  // namespace

@@ -230,7 +230,7 @@ double World<D>::choose_skin() const {
     fastest_squared = std::max(fastest_squared, norm_squared(p.velocity[i]));
   }
   const double lasting = 2.0 * skin_target_steps * settings_.time_step * std::sqrt(fastest_squared);
-  return std::clamp(lasting, skin_floor * smallest, skin_ceiling * smallest);
+  return std::clamp(lasting, skin_floor * smallest, skin_ceiling<D> * smallest);
 }
 
 template <int D>
