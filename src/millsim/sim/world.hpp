@@ -203,6 +203,10 @@ class World {
   std::vector<PairForce> cross_force_;
   std::vector<PairStatus> pair_status_;
   std::vector<double> pair_energy_;
+  // Per block of pairs, whether it is split between two threads' runs or holds a cross pair
+  // (then its pairs' status and energy are kept apart), and those blocks in order.
+  std::vector<std::uint8_t> block_mixed_;
+  std::vector<std::uint32_t> mixed_blocks_;
   // Work is split in blocks of a fixed size; each block keeps its own sums and ended
   // collisions, added up in block order, so results do not depend on the number of threads.
   std::vector<ContactDamping> pair_damping_;
