@@ -18,19 +18,20 @@ template <int D>
 bool NeighbourList<D>::needs_refresh(const std::vector<Vec<D>>& position) const {
   if (position.size() != reference_position_.size()) return true;
   const double limit = 0.25 * skin_ * skin_;  // (skin / 2)²
+  const auto moved_too_far = [&](std::size_t i) {
+    return norm_squared(separation(reference_position_[i], position[i])) > limit;
+  };
   const std::size_t count = position.size();
   if (count < parallel_search_threshold) {
     for (std::size_t i = 0; i < count; ++i) {
-      if (norm_squared(separation(reference_position_[i], position[i])) > limit) return true;
+      if (moved_too_far(i)) return true;
     }
     return false;
   }
   // Every step asks: on several threads, each looks at its share of the particles through.
   bool moved = false;
 #pragma omp parallel for schedule(static) reduction(|| : moved)
-  for (std::size_t i = 0; i < count; ++i) {
-    moved = moved || norm_squared(separation(reference_position_[i], position[i])) > limit;
-  }
+  for (std::size_t i = 0; i < count; ++i) moved = moved || moved_too_far(i);
   return moved;
 }
 

@@ -436,9 +436,6 @@ void World<D>::evaluate_pair_contacts() {
     torque[j] += r[j] * f.moment;
   };
 
-  // Each particle sums its pairs in pair order (pairs where it is second come first, as their
-  // first particle has the lower index): the order in which one thread going down the list
-  // meets them. On one thread the pairs add their forces to the particles as they go.
   // Block b, all of it, on one thread: each pair's force added as it goes, the block's
   // dissipation summed and its ended collisions listed in pair order.
   const auto whole_block = [&](std::size_t b) {
@@ -459,6 +456,9 @@ void World<D>::evaluate_pair_contacts() {
     pair_block_dissipated_[b] = dissipated;
     pair_block_ended_[b] = ended;
   };
+  // Each particle sums its pairs in pair order (pairs where it is second come first, as their
+  // first particle has the lower index): the order in which one thread going down the list
+  // meets them. On one thread the pairs add their forces to the particles as they go.
   if (!pairs_split_among_threads()) {
     std::fill(force.begin(), force.end(), Vec<D>{});
     std::fill(torque.begin(), torque.end(), Spin<D>{});
