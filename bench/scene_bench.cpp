@@ -212,13 +212,14 @@ ArrayEstimate estimate_array_bytes(const millsim::World<D>& world) {
   // Reference and cell-ordered positions, cell radii, home cells, four index arrays.
   constexpr double search_per_particle =
       2 * sizeof(Vec<D>) + sizeof(double) + sizeof(std::array<long, D>) + 4 * index;
-  // Dashpots, an ended-collision slot (type and energy); on several threads also this step's
-  // status and energy.
-  const double world_per_pair = sizeof(ContactDamping) + 2 * sizeof(double) +
-                                (omp_get_max_threads() > 1 ? 1.0 + sizeof(double) : 0.0);
-  // first, second and their rebuild copies, the search's found pair, the history and its
-  // rebuild copy.
-  constexpr double search_per_pair = 4 * index + 2 * index + 2 * sizeof(ContactHistory<D>);
+  // An ended-collision slot (type and energy); on several threads also this step's status and
+  // energy.
+  const double world_per_pair =
+      2 * sizeof(double) + (omp_get_max_threads() > 1 ? 1.0 + sizeof(double) : 0.0);
+  // first, second and their rebuild copies, the search's found pair, the history and the
+  // touching flag and their rebuild copies.
+  constexpr double search_per_pair =
+      4 * index + 2 * index + 2 * (sizeof(ContactHistory<D>) + sizeof(millsim::TouchState));
   ArrayEstimate estimate;
   estimate.pairs_per_particle = pairs / std::max(1.0, particles);
   estimate.bytes_per_particle = store + world_per_particle + search_per_particle +

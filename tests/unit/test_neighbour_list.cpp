@@ -70,7 +70,6 @@ void expect_default(const ContactHistory<D>& h) {
   EXPECT_EQ(h.tangential_spring, Vec<D>{});
   EXPECT_EQ(h.dissipated, 0.0);
   EXPECT_EQ(h.overlap, 0.0);
-  EXPECT_FALSE(h.touching);
 }
 
 // 300 particles, radii uniform in [0.5, 1.5], placed independently (so some overlap), skin 0.3.
@@ -203,7 +202,7 @@ void check_history_carry_over() {
     h.normal_spring_origin = -m;
     h.overlap = 2.0 * m;
     h.tangential_spring[0] = 3.0 * m;
-    h.touching = true;
+    list.touching()[p] = TouchState::touching;
   }
 
   // Everyone jiggles by up to 0.1 skin per axis (most pairs stay within reach, a few at the
@@ -229,6 +228,7 @@ void check_history_carry_over() {
     if (found == marker.end()) {
       ++fresh;
       expect_default(h);
+      EXPECT_EQ(list.touching()[p], TouchState::apart);
     } else {
       ++kept;
       const double m = found->second;
@@ -236,7 +236,7 @@ void check_history_carry_over() {
       EXPECT_EQ(h.normal_spring_origin, -m);
       EXPECT_EQ(h.overlap, 2.0 * m);
       EXPECT_EQ(h.tangential_spring[0], 3.0 * m);
-      EXPECT_TRUE(h.touching);
+      EXPECT_EQ(list.touching()[p], TouchState::touching);
     }
   }
   const std::size_t dropped = marker.size() - kept;

@@ -14,7 +14,6 @@ struct ContactHistory {
   Vec<D> tangential_spring{};  ///< F_s, kept perpendicular to the current normal
   double dissipated = 0.0;     ///< energy dissipated since the bodies first touched, J
   double overlap = 0.0;        ///< δ at the last evaluation, m (for the stored-energy account)
-  bool touching = false;       ///< the bodies overlap (the collision is under way)
 };
 
 /// Geometry and relative motion of one contact, body B relative to body A.

@@ -10,7 +10,9 @@
 namespace millsim {
 
 /// The dashpot coefficients of one contact, c = 2 ζ sqrt(k m*). They depend on the effective
-/// mass alone, so a pair's are worked out once per neighbour-list rebuild, not once a step.
+/// mass alone: World works out a wall contact's once per particle at each neighbour-list
+/// rebuild, and a pair's when it touches, from the two masses it has at hand (a per-pair array
+/// made at each rebuild missed the cache, bench/results.md).
 struct ContactDamping {
   double normal = 0.0;      ///< c_n, N s/m
   double tangential = 0.0;  ///< c_s, N s/m

@@ -217,6 +217,7 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
   // bodies A and B swapped: its tangential spring, the force on B, changes sign (the other
   // quantities of the history are the same for both bodies).
   next_history_.assign(next_first_.size(), ContactHistory<D>{});
+  next_touching_.assign(next_first_.size(), TouchState::apart);
   const std::size_t old_count = first_begin_.empty() ? 0 : first_begin_.size() - 1;
   const std::size_t pairs = next_first_.size();
 #pragma omp parallel for schedule(static) if (pairs >= parallel_search_threshold)
@@ -230,6 +231,7 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
          ++old) {
       if (second_[old] != b) continue;
       next_history_[p] = history_[old];
+      next_touching_[p] = touching_[old];
       if (swapped) next_history_[p].tangential_spring = -history_[old].tangential_spring;
       break;
     }
@@ -237,6 +239,7 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
   first_.swap(next_first_);
   second_.swap(next_second_);
   history_.swap(next_history_);
+  touching_.swap(next_touching_);
   if (into_cell_order && count > 0) {
     reference_position_.assign(cell_position_.begin(), cell_position_.end());
   } else {

@@ -14,6 +14,10 @@
 
 namespace millsim {
 
+/// Whether a listed pair's bodies overlap (a collision is under way). Not a character type, so
+/// that the step's writes of it do not oblige the compiler to reload everything else.
+enum class TouchState : std::uint8_t { apart, touching };
+
 template <int D>
 class NeighbourList {
  public:
@@ -55,6 +59,11 @@ class NeighbourList {
   const std::vector<std::uint32_t>& second() const { return second_; }
   std::vector<ContactHistory<D>>& history() { return history_; }
   const std::vector<ContactHistory<D>>& history() const { return history_; }
+  /// Per pair, whether its bodies overlap; carried over rebuilds with the history. Kept apart
+  /// from the history so that the step's distance test of a pair that is not touching (most
+  /// listed pairs) reads one byte, not a history record.
+  std::vector<TouchState>& touching() { return touching_; }
+  const std::vector<TouchState>& touching() const { return touching_; }
   /// Pairs of particle i as the first: [first_begin()[i], first_begin()[i + 1]).
   const std::vector<std::uint32_t>& first_begin() const { return first_begin_; }
   long rebuild_count() const { return rebuild_count_; }
@@ -68,6 +77,7 @@ class NeighbourList {
   long rebuild_count_ = 0;
   std::vector<std::uint32_t> first_, second_;
   std::vector<ContactHistory<D>> history_;
+  std::vector<TouchState> touching_;
   std::vector<std::uint32_t> first_begin_;
   std::vector<Vec<D>> reference_position_;
   // Scratch kept between rebuilds so that a rebuild allocates nothing in steady state.
@@ -80,6 +90,7 @@ class NeighbourList {
   std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found_;  // per search chunk
   std::vector<std::uint32_t> pair_cursor_;
   std::vector<ContactHistory<D>> next_history_;
+  std::vector<TouchState> next_touching_;
 };
 
 extern template class NeighbourList<2>;

@@ -113,16 +113,7 @@ void World<D>::refresh_neighbours() {
   neighbours_.rebuild(particles_.position, particles_.radius, into_cell_order);
   if (into_cell_order) reorder_particles(neighbours_.previous_index());
   const std::size_t pairs = neighbours_.pair_count();
-  pair_damping_.resize(pairs);
-  const auto& first = neighbours_.first();
-  const auto& second = neighbours_.second();
   const auto& m = particles_.mass;
-#pragma omp parallel for schedule(static) if (pairs >= parallel_threshold)
-  for (std::size_t p = 0; p < pairs; ++p) {
-    const std::uint32_t i = first[p];
-    const std::uint32_t j = second[p];
-    pair_damping_[p] = ball_ball_law_.damping(m[i] * m[j] / (m[i] + m[j]));
-  }
   wall_damping_.resize(count);
   for (std::size_t i = 0; i < count; ++i) wall_damping_[i] = ball_wall_law_.damping(m[i]);
   pair_ended_.resize(pairs);
@@ -330,10 +321,12 @@ void World<D>::split_pairs_among(int threads) {
   const auto ranges = static_cast<std::size_t>(threads);
   // Weighed by their cost: a pair that touches (the contact law) costs about four times one
   // that does not (a distance test), as the list was made.
-  const auto& history = neighbours_.history();
+  const auto& touching = neighbours_.touching();
   constexpr std::size_t touching_weight = 4;
   std::size_t total = 0;
-  for (std::size_t q = 0; q < pairs; ++q) total += history[q].touching ? touching_weight : 1;
+  for (std::size_t q = 0; q < pairs; ++q) {
+    total += touching[q] == TouchState::touching ? touching_weight : 1;
+  }
   split_particle_.assign(ranges + 1, static_cast<std::uint32_t>(count));
   split_pair_.assign(ranges + 1, static_cast<std::uint32_t>(pairs));
   split_particle_[0] = 0;
@@ -348,7 +341,7 @@ void World<D>::split_pairs_among(int threads) {
       ++t;
     }
     for (std::uint32_t q = first_begin[i]; q < first_begin[i + 1]; ++q) {
-      weight += history[q].touching ? touching_weight : 1;
+      weight += touching[q] == TouchState::touching ? touching_weight : 1;
     }
   }
   // Pairs whose second particle belongs to a later thread than their first (pairs are stored
@@ -382,12 +375,14 @@ void World<D>::evaluate_pair_contacts() {
   const auto& first = neighbours_.first();
   const auto& second = neighbours_.second();
   auto& history = neighbours_.history();
+  auto& touching = neighbours_.touching();
   const auto& x = particles_.position;
   const auto& v = velocity_now_;
   const auto& w = spin_now_;
   const auto& step_v = particles_.velocity;
   const auto& step_w = particles_.angular_velocity;
   const auto& r = particles_.radius;
+  const auto& m = particles_.mass;
   const double dt = settings_.time_step;
   const std::size_t pairs = first.size();
   const std::size_t blocks = pair_block_ended_.size();
@@ -404,9 +399,10 @@ void World<D>::evaluate_pair_contacts() {
     const double distance_squared = norm_squared(offset);
     const double reach = r[i] + r[j];
     if (distance_squared >= reach * reach) {
-      if (!history[q].touching) return {PairStatus::apart, 0.0};
+      if (touching[q] == TouchState::apart) return {PairStatus::apart, 0.0};
       const double energy = history[q].dissipated;
       history[q] = ContactHistory<D>{};
+      touching[q] = TouchState::apart;
       return {PairStatus::ended, energy};
     }
     const double distance = std::sqrt(distance_squared);
@@ -417,9 +413,13 @@ void World<D>::evaluate_pair_contacts() {
     in.spin_velocity = cross(in.normal, r[i] * w[i] + r[j] * w[j]);
     in.step_velocity = step_v[j] - step_v[i];
     in.step_spin_velocity = cross(in.normal, r[i] * step_w[i] + r[j] * step_w[j]);
-    history[q].touching = true;
+    touching[q] = TouchState::touching;
     history[q].overlap = in.overlap;
-    const ContactOutput<D> result = ball_ball_law_.evaluate(in, pair_damping_[q], history[q], dt);
+    // The dashpots' coefficients from the pair's effective mass, worked out here rather than
+    // read from a per-pair array made at each rebuild, whose entries, read only for the few
+    // listed pairs that touch, missed the cache.
+    const ContactDamping damping = ball_ball_law_.damping(m[i] * m[j] / (m[i] + m[j]));
+    const ContactOutput<D> result = ball_ball_law_.evaluate(in, damping, history[q], dt);
     out = {result.force, -cross(in.normal, result.tangential_force)};
     return {PairStatus::touching, result.dissipated};
   };
@@ -602,7 +602,6 @@ void World<D>::evaluate_wall_contacts() {
             in.step_velocity = particles_.velocity[i] - contact.wall_velocity;
             in.step_spin_velocity = cross(contact.normal, radius * particles_.angular_velocity[i]);
             ContactHistory<D>& history = slot_history[slot];
-            history.touching = true;
             history.overlap = contact.overlap;
             const ContactOutput<D> out = ball_wall_law_.evaluate(in, wall_damping_[i], history, dt);
             force += out.force;
@@ -682,7 +681,7 @@ void World<D>::advance_walls() {
 template <int D>
 std::size_t World<D>::touching_contacts() const {
   std::size_t count = 0;
-  for (const auto& h : neighbours_.history()) count += h.touching ? 1 : 0;
+  for (const auto t : neighbours_.touching()) count += t == TouchState::touching ? 1 : 0;
   for (const auto id : wall_slot_id_) count += id >= 0 ? 1 : 0;
   return count;
 }
@@ -711,8 +710,12 @@ double World<D>::potential_energy() const {
 template <int D>
 double World<D>::stored_spring_energy() const {
   double energy = 0.0;
-  for (const auto& h : neighbours_.history()) {
-    if (h.touching) energy += ball_ball_law_.stored_energy(h, h.overlap);
+  const auto& history = neighbours_.history();
+  const auto& touching = neighbours_.touching();
+  for (std::size_t q = 0; q < history.size(); ++q) {
+    if (touching[q] == TouchState::touching) {
+      energy += ball_ball_law_.stored_energy(history[q], history[q].overlap);
+    }
   }
   for (std::size_t s = 0; s < wall_slot_id_.size(); ++s) {
     if (wall_slot_id_[s] >= 0) {

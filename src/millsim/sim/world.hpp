@@ -209,7 +209,6 @@ class World {
   std::vector<std::uint32_t> mixed_blocks_;
   // Work is split in blocks of a fixed size; each block keeps its own sums and ended
   // collisions, added up in block order, so results do not depend on the number of threads.
-  std::vector<ContactDamping> pair_damping_;
   std::vector<EndedCollision> pair_ended_;  // block b's at [b × pair_block, ...)
   std::vector<std::uint32_t> pair_block_ended_;
   std::vector<double> pair_block_dissipated_;
