@@ -129,8 +129,6 @@ void World<D>::refresh_neighbours() {
   wall_candidates_.clear();
   next_wall_slot_id_.clear();
   next_wall_slot_history_.clear();
-  wall_force_.assign(count, Vec<D>{});
-  wall_moment_.assign(count, Spin<D>{});
   for (std::size_t i = 0; i < count; ++i) {
     const std::uint32_t held = wall_slots_of_[i];
     const std::size_t from = static_cast<std::size_t>(held) * slots;
@@ -620,8 +618,9 @@ void World<D>::evaluate_wall_contacts() {
         slot_history[slot] = ContactHistory<D>{};
         slot_id[slot] = -1;
       }
-      wall_force_[i] = force;
-      wall_moment_[i] = moment;
+      // Added to the particle's sums after its pairs (the pair stage is done), before gravity.
+      particles_.force[i] += force;
+      particles_.torque[i] += moment;
     }
     wall_block_torque_[b] = torque;
     wall_block_work_[b] = work;
@@ -642,8 +641,8 @@ void World<D>::evaluate_wall_contacts() {
 template <int D>
 void World<D>::accumulate_forces_and_integrate() {
   // Each particle's forces are summed in a fixed order, so the sums are the same on every run
-  // and thread count: its pairs in pair order (the pair stage has added them into force and
-  // torque), then walls, then gravity. Then the particle is advanced, in the same pass (one
+  // and thread count: its pairs in pair order, then walls (the pair and wall stages have added
+  // them into force and torque), then gravity. Then the particle is advanced, in the same pass (one
   // read of its arrays instead of two): leapfrog u̇(n+½) = u̇(n−½) + ü(n) Δt,
   // u(n+1) = u(n) + u̇(n+½) Δt; the same for rotation.
   auto& p = particles_;
@@ -654,8 +653,7 @@ void World<D>::accumulate_forces_and_integrate() {
   const double dt = settings_.time_step;
   const std::size_t count = p.size();
   for_each_particle([&](std::size_t i) {
-    force[i] = (force[i] + wall_force_[i]) + m[i] * gravity;
-    torque[i] += wall_moment_[i];
+    force[i] += m[i] * gravity;
     p.velocity[i] += (p.inverse_mass[i] * dt) * force[i];
     p.position[i] += dt * p.velocity[i];
     p.angular_velocity[i] += (p.inverse_inertia[i] * dt) * torque[i];

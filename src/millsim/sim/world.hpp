@@ -213,11 +213,8 @@ class World {
   std::vector<std::uint32_t> pair_block_ended_;
   std::vector<double> pair_block_dissipated_;
 
-  // Particles that may touch a wall before the next neighbour-list rebuild, and per particle
-  // the force and moment its walls exert (zero for the others).
+  // Particles that may touch a wall before the next neighbour-list rebuild.
   std::vector<std::uint32_t> wall_candidates_;
-  std::vector<Vec<D>> wall_force_;
-  std::vector<Spin<D>> wall_moment_;
   std::vector<ContactDamping> wall_damping_;  // per particle, set at each rebuild
   // Per wall candidate (in the order of wall_candidates_), max_wall_contacts slots of
   // wall-contact history keyed by wall id; per particle, which candidate's slots are its own
