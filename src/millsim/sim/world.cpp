@@ -387,26 +387,18 @@ void World<D>::evaluate_pair_contacts() {
   auto& force = particles_.force;
   auto& torque = particles_.torque;
 
-  // Pair q: its contact this step. Writes the force on the second particle and the moment both
-  // receive (scaled by their radii) to `out` if the pair touches, and returns what happened.
-  const auto evaluate = [&](std::size_t q, PairForce & out) __attribute__((always_inline))
-                            ->PairOutcome {
+  // Pair q, whose bodies overlap (centres `offset` apart, its length squared given): its
+  // contact this step. Writes the force on the second particle and the moment both receive
+  // (scaled by their radii) to `out` and returns the energy dissipated.
+  const auto touching_contact = [&](std::size_t q, const Vec<D>& offset, double distance_squared,
+                                    PairForce& out) __attribute__((always_inline))
+                                    ->double {
     const std::uint32_t i = first[q];
     const std::uint32_t j = second[q];
-    const Vec<D> offset = neighbours_.separation(x[i], x[j]);
-    const double distance_squared = norm_squared(offset);
-    const double reach = r[i] + r[j];
-    if (distance_squared >= reach * reach) {
-      if (touching[q] == TouchState::apart) return {PairStatus::apart, 0.0};
-      const double energy = history[q].dissipated;
-      history[q] = ContactHistory<D>{};
-      touching[q] = TouchState::apart;
-      return {PairStatus::ended, energy};
-    }
     const double distance = std::sqrt(distance_squared);
     ContactInput<D> in;
     in.normal = offset * (1.0 / distance);
-    in.overlap = reach - distance;
+    in.overlap = (r[i] + r[j]) - distance;
     in.velocity = v[j] - v[i];
     in.spin_velocity = cross(in.normal, r[i] * w[i] + r[j] * w[j]);
     in.step_velocity = step_v[j] - step_v[i];
@@ -419,7 +411,25 @@ void World<D>::evaluate_pair_contacts() {
     const ContactDamping damping = ball_ball_law_.damping(m[i] * m[j] / (m[i] + m[j]));
     const ContactOutput<D> result = ball_ball_law_.evaluate(in, damping, history[q], dt);
     out = {result.force, -cross(in.normal, result.tangential_force)};
-    return {PairStatus::touching, result.dissipated};
+    return result.dissipated;
+  };
+  // A pair whose bodies do not overlap: if they did until now, its collision ends here and
+  // its history is forgotten; returns what happened and the collision's energy.
+  const auto apart = [&](std::size_t q) -> PairOutcome {
+    if (touching[q] == TouchState::apart) return {PairStatus::apart, 0.0};
+    const double energy = history[q].dissipated;
+    history[q] = ContactHistory<D>{};
+    touching[q] = TouchState::apart;
+    return {PairStatus::ended, energy};
+  };
+  // Pair q: its contact this step, as touching_contact, or apart.
+  const auto evaluate = [&](std::size_t q, PairForce & out) __attribute__((always_inline))
+                            ->PairOutcome {
+    const Vec<D> offset = neighbours_.separation(x[first[q]], x[second[q]]);
+    const double distance_squared = norm_squared(offset);
+    const double reach = r[first[q]] + r[second[q]];
+    if (distance_squared >= reach * reach) return apart(q);
+    return {PairStatus::touching, touching_contact(q, offset, distance_squared, out)};
   };
   // Adds a touching pair's force and moment to its particles: −F on the first, +F on the
   // second.
@@ -434,22 +444,39 @@ void World<D>::evaluate_pair_contacts() {
     torque[j] += r[j] * f.moment;
   };
 
-  // Block b, all of it, on one thread: each pair's force added as it goes, the block's
+  // Block b, all of it, on one thread: each pair's force added in pair order, the block's
   // dissipation summed and its ended collisions listed in pair order.
   const auto whole_block = [&](std::size_t b) {
     double dissipated = 0.0;
     std::uint32_t ended = 0;
-    const std::size_t end = std::min(pairs, (b + 1) * pair_block);
-    for (std::size_t q = b * pair_block; q < end; ++q) {
-      PairForce f;
-      const PairOutcome outcome = evaluate(q, f);
-      if (outcome.status == PairStatus::ended) {
-        pair_ended_[b * pair_block + ended++] = {ContactType::ball_ball, outcome.energy};
-      } else if (outcome.status == PairStatus::touching) {
-        add_to_first(q, f);
-        add_to_second(q, f);
-        dissipated += outcome.energy;
+    const std::size_t begin = b * pair_block;
+    const std::size_t end = std::min(pairs, begin + pair_block);
+    // Pairs that overlap now or did until now, in pair order: the rest need nothing. Listed
+    // without a branch (a third of the 2D SAG scene's listed pairs touch, scattered among the
+    // others, which the processor could only mispredict).
+    std::array<std::uint32_t, pair_block> listed;
+    std::size_t count = 0;
+    for (std::size_t q = begin; q < end; ++q) {
+      const Vec<D> offset = neighbours_.separation(x[first[q]], x[second[q]]);
+      const double reach = r[first[q]] + r[second[q]];
+      const unsigned overlaps = norm_squared(offset) < reach * reach ? 1U : 0U;
+      const unsigned touched = touching[q] == TouchState::touching ? 1U : 0U;
+      listed[count] = static_cast<std::uint32_t>(q);
+      count += overlaps | touched;
+    }
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::size_t q = listed[k];
+      const Vec<D> offset = neighbours_.separation(x[first[q]], x[second[q]]);
+      const double distance_squared = norm_squared(offset);
+      const double reach = r[first[q]] + r[second[q]];
+      if (distance_squared >= reach * reach) {
+        pair_ended_[begin + ended++] = {ContactType::ball_ball, apart(q).energy};
+        continue;
       }
+      PairForce f;
+      dissipated += touching_contact(q, offset, distance_squared, f);
+      add_to_first(q, f);
+      add_to_second(q, f);
     }
     pair_block_dissipated_[b] = dissipated;
     pair_block_ended_[b] = ended;
