@@ -298,11 +298,11 @@ void report(const millsim::MillPlan& plan, const BenchOptions& options,
   fmt::print("particle-steps/s  {:.4g} (wall clock); {:.4g} per CPU second\n",
              particle_steps / measured.wall_seconds, particle_steps / measured.cpu_seconds);
   fmt::print(
-      "neighbour rebuilds {} ({:.1f} steps apart, skin {:.3g} mm at the end), {} contacts at the "
-      "end\n",
+      "neighbour rebuilds {} ({:.1f} steps apart, skin {:.3g} mm at the end), {} contacts and {} "
+      "wall candidates at the end\n",
       measured.rebuilds,
       static_cast<double>(options.steps) / static_cast<double>(std::max(1L, measured.rebuilds)),
-      1e3 * world.neighbour_skin(), world.touching_contacts());
+      1e3 * world.neighbour_skin(), world.touching_contacts(), world.wall_candidate_count());
   fmt::print("real-time factor  {:.4g} (mill seconds per wall second)\n",
              static_cast<double>(options.steps) * plan.time_step / measured.wall_seconds);
   fmt::print("memory/particle   {:.0f} bytes (resident growth while building and running {})\n",
