@@ -166,7 +166,10 @@ void Walls<D>::for_each_contact(const Vec<D>& centre, double particle_radius, Em
                                 const NearbyLifters* nearby) const {
   int id_offset = 0;
   if (mill) {
-    WallContact<D> found[max_mill_contacts<D>];
+    // One buffer per thread, made once: a fresh array here was zeroed for every wall candidate
+    // and step (528 bytes in 3D, 4 % of the 3D step's instructions). mill_contacts writes every
+    // field of each contact it reports, so nothing of an earlier call is read.
+    static thread_local WallContact<D> found[max_mill_contacts<D>];
     const int count = mill_contacts(*mill, centre, particle_radius, found, nearby);
     for (int k = 0; k < count; ++k) emit(found[k]);
     id_offset = mill_wall_count();
