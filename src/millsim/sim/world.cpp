@@ -466,17 +466,15 @@ void World<D>::evaluate_pair_contacts() {
     }
     for (std::size_t k = 0; k < count; ++k) {
       const std::size_t q = listed[k];
-      const Vec<D> offset = neighbours_.separation(x[first[q]], x[second[q]]);
-      const double distance_squared = norm_squared(offset);
-      const double reach = r[first[q]] + r[second[q]];
-      if (distance_squared >= reach * reach) {
-        pair_ended_[begin + ended++] = {ContactType::ball_ball, apart(q).energy};
-        continue;
-      }
       PairForce f;
-      dissipated += touching_contact(q, offset, distance_squared, f);
-      add_to_first(q, f);
-      add_to_second(q, f);
+      const PairOutcome outcome = evaluate(q, f);
+      if (outcome.status == PairStatus::ended) {
+        pair_ended_[begin + ended++] = {ContactType::ball_ball, outcome.energy};
+      } else if (outcome.status == PairStatus::touching) {
+        add_to_first(q, f);
+        add_to_second(q, f);
+        dissipated += outcome.energy;
+      }
     }
     pair_block_dissipated_[b] = dissipated;
     pair_block_ended_[b] = ended;
