@@ -387,18 +387,26 @@ void World<D>::evaluate_pair_contacts() {
   auto& force = particles_.force;
   auto& torque = particles_.torque;
 
-  // Pair q, whose bodies overlap (centres `offset` apart, its length squared given): its
-  // contact this step. Writes the force on the second particle and the moment both receive
-  // (scaled by their radii) to `out` and returns the energy dissipated.
-  const auto touching_contact = [&](std::size_t q, const Vec<D>& offset, double distance_squared,
-                                    PairForce& out) __attribute__((always_inline))
-                                    ->double {
+  // Pair q: its contact this step. Writes the force on the second particle and the moment both
+  // receive (scaled by their radii) to `out` if the pair touches, and returns what happened.
+  const auto evaluate = [&](std::size_t q, PairForce & out) __attribute__((always_inline))
+                            ->PairOutcome {
     const std::uint32_t i = first[q];
     const std::uint32_t j = second[q];
+    const Vec<D> offset = neighbours_.separation(x[i], x[j]);
+    const double distance_squared = norm_squared(offset);
+    const double reach = r[i] + r[j];
+    if (distance_squared >= reach * reach) {
+      if (touching[q] == TouchState::apart) return {PairStatus::apart, 0.0};
+      const double energy = history[q].dissipated;
+      history[q] = ContactHistory<D>{};
+      touching[q] = TouchState::apart;
+      return {PairStatus::ended, energy};
+    }
     const double distance = std::sqrt(distance_squared);
     ContactInput<D> in;
     in.normal = offset * (1.0 / distance);
-    in.overlap = (r[i] + r[j]) - distance;
+    in.overlap = reach - distance;
     in.velocity = v[j] - v[i];
     in.spin_velocity = cross(in.normal, r[i] * w[i] + r[j] * w[j]);
     in.step_velocity = step_v[j] - step_v[i];
@@ -411,25 +419,7 @@ void World<D>::evaluate_pair_contacts() {
     const ContactDamping damping = ball_ball_law_.damping(m[i] * m[j] / (m[i] + m[j]));
     const ContactOutput<D> result = ball_ball_law_.evaluate(in, damping, history[q], dt);
     out = {result.force, -cross(in.normal, result.tangential_force)};
-    return result.dissipated;
-  };
-  // A pair whose bodies do not overlap: if they did until now, its collision ends here and
-  // its history is forgotten; returns what happened and the collision's energy.
-  const auto apart = [&](std::size_t q) -> PairOutcome {
-    if (touching[q] == TouchState::apart) return {PairStatus::apart, 0.0};
-    const double energy = history[q].dissipated;
-    history[q] = ContactHistory<D>{};
-    touching[q] = TouchState::apart;
-    return {PairStatus::ended, energy};
-  };
-  // Pair q: its contact this step, as touching_contact, or apart.
-  const auto evaluate = [&](std::size_t q, PairForce & out) __attribute__((always_inline))
-                            ->PairOutcome {
-    const Vec<D> offset = neighbours_.separation(x[first[q]], x[second[q]]);
-    const double distance_squared = norm_squared(offset);
-    const double reach = r[first[q]] + r[second[q]];
-    if (distance_squared >= reach * reach) return apart(q);
-    return {PairStatus::touching, touching_contact(q, offset, distance_squared, out)};
+    return {PairStatus::touching, result.dissipated};
   };
   // Adds a touching pair's force and moment to its particles: −F on the first, +F on the
   // second.
