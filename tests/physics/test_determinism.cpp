@@ -83,8 +83,10 @@ World<D> moving_scene(const MillPlan& plan, double inner, double compress, doubl
 
 /// Steps a copy of `scene` `steps` times on `threads` threads, recording the collisions that
 /// end.
+/// With avx2_lanes false, the pair stage's lanes use the instructions of any x86-64 processor
+/// instead of AVX2 (World::set_avx2_lanes).
 template <int D>
-Outcome<D> step_on(const World<D>& scene, int steps, int threads) {
+Outcome<D> step_on(const World<D>& scene, int steps, int threads, bool avx2_lanes = true) {
   const ThreadCount thread_count(threads);
   EXPECT_EQ(omp_get_max_threads(), threads);
   int team = 0;
@@ -95,6 +97,7 @@ Outcome<D> step_on(const World<D>& scene, int steps, int threads) {
   }
   EXPECT_EQ(team, threads) << "OpenMP did not give the team asked for";
   Outcome<D> outcome{scene, ImpactSpectrum{}, threads};
+  outcome.world.set_avx2_lanes(avx2_lanes);
   outcome.world.record_collisions_in(&outcome.spectrum);
   for (int n = 0; n < steps; ++n) outcome.world.step();
   outcome.world.record_collisions_in(nullptr);
@@ -160,7 +163,8 @@ void expect_identical(const Outcome<D>& one, const Outcome<D>& two) {
                       a.angular_velocity[i] == b.angular_velocity[i] && a.force[i] == b.force[i] &&
                       a.torque[i] == b.torque[i];
     if (!same && differing++ < 5) {
-      ADD_FAILURE() << "particle " << i << " differs between 1 and " << two.threads << " threads";
+      ADD_FAILURE() << "particle " << i << " differs between 1 and " << two.threads << " threads"
+                    << (two.world.avx2_lanes() ? "" : " (without AVX2)");
     }
   }
   EXPECT_EQ(differing, 0u) << "particles that differ";
@@ -207,6 +211,11 @@ TEST(Determinism, SagMill2DIsTheSameOnOneTwoAndThreeThreads) {
   // cores is fine: only the order of the sums is at stake).
   const Outcome<2> three = step_on(scene, 400, 3);
   expect_identical(one, three);
+  // The pair stage's lanes without AVX2, where the processor has it (else the same run twice).
+  EXPECT_EQ(one.world.avx2_lanes(), __builtin_cpu_supports("avx2") != 0);
+  const Outcome<2> baseline = step_on(scene, 400, 1, false);
+  EXPECT_FALSE(baseline.world.avx2_lanes());
+  expect_identical(one, baseline);
 
   // The parallel paths ran: particles and listed pairs above the threshold (the wall stage's
   // candidates, the discs near the shell, stay below it here; the 3D scene covers it), and the
@@ -286,6 +295,7 @@ void expect_3d_scene_deterministic(bool periodic) {
   expect_identical(one, two);
   const Outcome<3> three = step_on(scene, 400, 3);
   expect_identical(one, three);
+  expect_identical(one, step_on(scene, 400, 2, false));
 
   const World<3>& world = one.world;
   EXPECT_GT(world.particles().size(), parallel_threshold);

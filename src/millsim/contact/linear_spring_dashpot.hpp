@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "millsim/contact/contact.hpp"
+#include "millsim/core/lanes.hpp"
 #include "millsim/particles/material.hpp"
 
 namespace millsim {
@@ -13,13 +14,18 @@ namespace millsim {
 /// mass alone: World works out a wall contact's once per particle at each neighbour-list
 /// rebuild, and a pair's when it touches, from the two masses it has at hand (a per-pair array
 /// made at each rebuild missed the cache, bench/results.md).
-struct ContactDamping {
-  double normal = 0.0;      ///< c_n, N s/m
-  double tangential = 0.0;  ///< c_s, N s/m
+template <class T>
+struct ContactDampingOf {
+  T normal{};      ///< c_n, N s/m
+  T tangential{};  ///< c_s, N s/m
 };
+using ContactDamping = ContactDampingOf<double>;
 
 /// Stateless: its members are parameters, all state lives in the ContactHistory it is given.
 /// Particle–particle and particle–wall contacts use this same law; only the inputs differ.
+/// It is written once for a number type T: double for one contact, Lanes (core/lanes.hpp) for
+/// several at once, each lane getting the same bits a double would. Hence no branches: where the
+/// contact breaks or slips, both outcomes are worked out and the right one chosen.
 class LinearSpringDashpot {
  public:
   /// allow_tension = false is the model of MODEL.md (the total normal force never pulls; the
@@ -47,10 +53,11 @@ class LinearSpringDashpot {
   }
 
   /// c_n = 2 ζ sqrt(k_n) sqrt(m*) and c_s = 2 ζ sqrt(k_s) sqrt(m*) for effective mass m*.
-  ContactDamping damping(double effective_mass) const {
-    const double sqrt_mass = std::sqrt(effective_mass);
-    return {2.0 * damping_ratio_ * sqrt_normal_stiffness_ * sqrt_mass,
-            2.0 * damping_ratio_ * sqrt_tangential_stiffness_ * sqrt_mass};
+  template <class T>
+  [[gnu::always_inline]] ContactDampingOf<T> damping(T effective_mass) const {
+    const T sqrt_mass = lane_sqrt(effective_mass);
+    return {splat<T>(2.0 * damping_ratio_ * sqrt_normal_stiffness_) * sqrt_mass,
+            splat<T>(2.0 * damping_ratio_ * sqrt_tangential_stiffness_) * sqrt_mass};
   }
 
   template <int D>
@@ -62,42 +69,41 @@ class LinearSpringDashpot {
   /// The same with the dashpot coefficients given (from damping(in.effective_mass)).
   /// Always inlined: the pair and wall loops call it once per contact and step, and the
   /// inputs and outputs then stay in registers.
-  template <int D>
-  ContactOutput<D> evaluate(const ContactInput<D>& in, const ContactDamping& damping,
-                            ContactHistory<D>& history, double time_step) const {
-    const Vec<D>& n = in.normal;
-    const double normal_speed = dot(in.velocity, n);  // v·n < 0 while the pair approaches
-    const Vec<D> sliding_velocity = in.velocity - normal_speed * n + in.spin_velocity;  // v_s
-    const Vec<D> step_sliding_velocity =
+  template <int D, class T>
+  [[gnu::always_inline]] ContactOutput<D, T> evaluate(const ContactInput<D, T>& in,
+                                                      const ContactDampingOf<T>& damping,
+                                                      ContactHistory<D, T>& history,
+                                                      double time_step) const {
+    using V = Vec<D, T>;
+    const T dt = splat<T>(time_step);
+    const T k_n = splat<T>(normal_stiffness_);
+    const T k_s = splat<T>(tangential_stiffness_);
+    const V& n = in.normal;
+    const T normal_speed = dot(in.velocity, n);  // v·n < 0 while the pair approaches
+    const V sliding_velocity = in.velocity - normal_speed * n + in.spin_velocity;  // v_s
+    const V step_sliding_velocity =
         in.step_velocity - dot(in.step_velocity, n) * n + in.step_spin_velocity;
 
     // Normal: spring k_n (δ − origin) and dashpot D_n = −c_n v_n, c_n = 2 ζ sqrt(k_n m*).
-    const double normal_damping = damping.normal;
-    const double normal_spring = normal_stiffness_ * (in.overlap - history.normal_spring_origin);
-    const double normal_force = normal_spring - normal_damping * normal_speed;
+    const T normal_damping = damping.normal;
+    const T normal_spring = k_n * (in.overlap - history.normal_spring_origin);
+    const T normal_force = normal_spring - normal_damping * normal_speed;
 
     // R(F_s): turn the stored tangential spring into the current tangent plane, keeping its
     // length (in 2D this is the exact rotation; in 3D a first-order one).
-    Vec<D> spring = history.tangential_spring;
-    const double spring_length_squared = norm_squared(spring);
-    if (spring_length_squared > 0.0) {
-      spring -= dot(spring, n) * n;
-      const double projected = norm_squared(spring);
-      spring *= projected > 0.0 ? std::sqrt(spring_length_squared / projected) : 0.0;
-    }
+    const V stored = history.tangential_spring;
+    const T spring_length_squared = norm_squared(stored);
+    const V projected_spring = stored - dot(stored, n) * n;
+    const T projected = norm_squared(projected_spring);
+    const T rescale = select(projected > 0.0, lane_sqrt(spring_length_squared / projected), T{});
+    V spring = select(spring_length_squared > 0.0, projected_spring * rescale, stored);
 
-    ContactOutput<D> out;
-    if (normal_force <= 0.0 && !allow_tension_) {
-      // No tension: the contact breaks and forgets its springs; what they held is lost.
-      const double held = std::max(0.0, normal_spring);
-      out.dissipated = held * held / (2.0 * normal_stiffness_) +
-                       norm_squared(spring) / (2.0 * tangential_stiffness_);
-      history.normal_spring_origin = in.overlap;
-      history.tangential_spring = Vec<D>{};
-      history.dissipated += out.dissipated;
-      return out;
-    }
-    out.dissipated = normal_damping * normal_speed * normal_speed * time_step;  // |D_n·v_n| Δt
+    // No tension: where the total normal force would pull, the contact breaks and forgets its
+    // springs; what they held is lost.
+    const Mask<T> breaks = allow_tension_ ? Mask<T>{} : normal_force <= 0.0;
+    const T held = select(T{} < normal_spring, normal_spring, T{});  // max(0, spring)
+    const T broken_dissipated = held * held / (2.0 * k_n) + norm_squared(spring) / (2.0 * k_s);
+    const T dashpot_dissipated = normal_damping * normal_speed * normal_speed * dt;  // |D_n·v_n| Δt
 
     // Tangential spring F_s ← R(F_s) − k_s v_s Δt, dashpot D_s = −c_s v_s. Coulomb: when the
     // trial tangential force F_s + D_s exceeds μ F_N (F_N the total normal force) the contact
@@ -105,32 +111,38 @@ class LinearSpringDashpot {
     // dropped). Capping the whole force, not only the spring, keeps the friction impulse at
     // most μ times the normal one: at the touch of an oblique impact the spring is still small
     // while the dashpot already carries c_s times the whole incoming slip.
-    const Vec<D> spring_before = spring;
-    const Vec<D> step_slip = time_step * step_sliding_velocity;  // Δs, B relative to A
-    spring -= tangential_stiffness_ * step_slip;
-    const double friction_limit = friction_ * std::abs(normal_force);
-    const double tangential_damping = damping.tangential;
-    const Vec<D> trial = spring - tangential_damping * sliding_velocity;
+    const V spring_before = spring;
+    const V step_slip = dt * step_sliding_velocity;  // Δs, B relative to A
+    spring -= k_s * step_slip;
+    const T friction_limit = splat<T>(friction_) * lane_abs(normal_force);
+    const T tangential_damping = damping.tangential;
+    const V trial = spring - tangential_damping * sliding_velocity;
     // Compared squared, so that a sticking contact (most of them) needs no square root.
-    const double trial_length_squared = norm_squared(trial);
-    if (trial_length_squared > friction_limit * friction_limit) {
-      // Slipping. The friction work is the work the force does against the slip at the time
-      // of the positions (the work the leapfrog update sees, as for the dashpots) less what the
-      // spring took up: −F_t·v_s Δt − (|F_s|² − |F_s,before|²) / (2 k_s). (With the half-step
-      // slip instead, every slipping step books F_t·a_s Δt²/2 too much, a sum that does not
-      // cancel: 4 % of the power of a 3D mill.) In steady sliding it is μ F_N |v_s| Δt.
-      spring = trial * (friction_limit / std::sqrt(trial_length_squared));
-      out.tangential_force = spring;
-      out.dissipated +=
-          -time_step * dot(spring, sliding_velocity) +
-          (norm_squared(spring_before) - norm_squared(spring)) / (2.0 * tangential_stiffness_);
-    } else {
-      out.tangential_force = trial;
-      out.dissipated += tangential_damping * norm_squared(sliding_velocity) * time_step;
-    }
-    history.tangential_spring = spring;
+    const T trial_length_squared = norm_squared(trial);
+    const Mask<T> slips = trial_length_squared > friction_limit * friction_limit;
+    // Slipping. The friction work is the work the force does against the slip at the time
+    // of the positions (the work the leapfrog update sees, as for the dashpots) less what the
+    // spring took up: −F_t·v_s Δt − (|F_s|² − |F_s,before|²) / (2 k_s). (With the half-step
+    // slip instead, every slipping step books F_t·a_s Δt²/2 too much, a sum that does not
+    // cancel: 4 % of the power of a 3D mill.) In steady sliding it is μ F_N |v_s| Δt.
+    const V slipping_spring = trial * (friction_limit / lane_sqrt(trial_length_squared));
+    const T slipping_dissipated =
+        dashpot_dissipated +
+        (-dt * dot(slipping_spring, sliding_velocity) +
+         (norm_squared(spring_before) - norm_squared(slipping_spring)) / (2.0 * k_s));
+    // Sticking: the dashpot dissipates c_s |v_s|² Δt.
+    const T sticking_dissipated =
+        dashpot_dissipated + tangential_damping * norm_squared(sliding_velocity) * dt;
+    const V tangential_force = select(slips, slipping_spring, trial);
+
+    ContactOutput<D, T> out;
+    out.tangential_force = select(breaks, V{}, tangential_force);
+    out.force = select(breaks, V{}, normal_force * n + tangential_force);
+    out.dissipated =
+        select(breaks, broken_dissipated, select(slips, slipping_dissipated, sticking_dissipated));
+    history.normal_spring_origin = select(breaks, in.overlap, history.normal_spring_origin);
+    history.tangential_spring = select(breaks, V{}, select(slips, slipping_spring, spring));
     history.dissipated += out.dissipated;
-    out.force = normal_force * n + out.tangential_force;
     return out;
   }
 

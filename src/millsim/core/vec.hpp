@@ -1,7 +1,9 @@
 // Small fixed-size vectors shared by the 2D and 3D engines.
 //
 // Vec<D> is a plain aggregate of D doubles; Spin<D> is the type of an angular velocity or a
-// torque: a scalar about the out-of-plane axis in 2D, a vector in 3D.
+// torque: a scalar about the out-of-plane axis in 2D, a vector in 3D. Vec<D, T> holds D of
+// some other number type: the contact law also runs on Lanes (core/lanes.hpp), several
+// contacts at once, with the same arithmetic.
 #pragma once
 
 #include <array>
@@ -10,13 +12,13 @@
 
 namespace millsim {
 
-template <int D>
+template <int D, class T = double>
 struct Vec {
   static_assert(D == 2 || D == 3, "millsim works in two or three dimensions");
-  std::array<double, D> c{};
+  std::array<T, D> c{};
 
-  constexpr double& operator[](int i) { return c[static_cast<std::size_t>(i)]; }
-  constexpr double operator[](int i) const { return c[static_cast<std::size_t>(i)]; }
+  constexpr T& operator[](int i) { return c[static_cast<std::size_t>(i)]; }
+  constexpr T operator[](int i) const { return c[static_cast<std::size_t>(i)]; }
 
   constexpr Vec& operator+=(const Vec& o) {
     for (int i = 0; i < D; ++i) (*this)[i] += o[i];
@@ -26,29 +28,32 @@ struct Vec {
     for (int i = 0; i < D; ++i) (*this)[i] -= o[i];
     return *this;
   }
-  constexpr Vec& operator*=(double s) {
+  constexpr Vec& operator*=(T s) {
     for (int i = 0; i < D; ++i) (*this)[i] *= s;
     return *this;
   }
   friend constexpr Vec operator+(Vec a, const Vec& b) { return a += b; }
   friend constexpr Vec operator-(Vec a, const Vec& b) { return a -= b; }
-  friend constexpr Vec operator*(Vec a, double s) { return a *= s; }
-  friend constexpr Vec operator*(double s, Vec a) { return a *= s; }
-  friend constexpr Vec operator-(Vec a) { return a *= -1.0; }
+  friend constexpr Vec operator*(Vec a, T s) { return a *= s; }
+  friend constexpr Vec operator*(T s, Vec a) { return a *= s; }
+  friend constexpr Vec operator-(Vec a) {
+    for (int i = 0; i < D; ++i) a[i] = -a[i];
+    return a;
+  }
   friend constexpr bool operator==(const Vec&, const Vec&) = default;
 };
 
 using Vec2 = Vec<2>;
 using Vec3 = Vec<3>;
 
-template <int D>
-constexpr double dot(const Vec<D>& a, const Vec<D>& b) {
-  double s = 0.0;
+template <int D, class T>
+constexpr T dot(const Vec<D, T>& a, const Vec<D, T>& b) {
+  T s{};
   for (int i = 0; i < D; ++i) s += a[i] * b[i];
   return s;
 }
-template <int D>
-constexpr double norm_squared(const Vec<D>& a) {
+template <int D, class T>
+constexpr T norm_squared(const Vec<D, T>& a) {
   return dot(a, a);
 }
 template <int D>
@@ -61,20 +66,24 @@ template <int D>
 using Spin = std::conditional_t<D == 2, double, Vec3>;
 
 /// n × s for a vector n and a spin s. In 2D s is along +z: (n_x, n_y, 0) × (0, 0, s).
-inline constexpr Vec2 cross(const Vec2& n, double s) {
-  return Vec2{{n[1] * s, -n[0] * s}};
+template <class T>
+constexpr Vec<2, T> cross(const Vec<2, T>& n, T s) {
+  return Vec<2, T>{{n[1] * s, -n[0] * s}};
 }
 /// s × r for a spin s along +z and a vector r in the plane: the velocity of a point at r.
 inline constexpr Vec2 cross(double s, const Vec2& r) {
   return Vec2{{-s * r[1], s * r[0]}};
 }
 /// a × b for two plane vectors: the z component.
-inline constexpr double cross(const Vec2& a, const Vec2& b) {
+template <class T>
+constexpr T cross(const Vec<2, T>& a, const Vec<2, T>& b) {
   return a[0] * b[1] - a[1] * b[0];
 }
 
-inline constexpr Vec3 cross(const Vec3& a, const Vec3& b) {
-  return Vec3{{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
+template <class T>
+constexpr Vec<3, T> cross(const Vec<3, T>& a, const Vec<3, T>& b) {
+  return Vec<3, T>{
+      {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
 }
 
 inline constexpr double spin_dot(double a, double b) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <type_traits>
+#include <utility>
 
 namespace millsim {
 namespace {
@@ -31,6 +32,19 @@ constexpr std::size_t parallel_threshold = 2048;
 /// (the 2D SAG scene has about a thousand candidates; on one thread they held the other one
 /// waiting for 3 % of the step).
 constexpr std::size_t parallel_wall_threshold = 2 * wall_block;
+
+/// Whether this processor has AVX2 (asked once).
+bool processor_has_avx2() {
+#if defined(__x86_64__)
+  static const bool has = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") != 0;
+  }();
+  return has;
+#else
+  return false;
+#endif
+}
 
 std::size_t block_count(std::size_t items, std::size_t block) {
   return (items + block - 1) / block;
@@ -70,6 +84,12 @@ World<D>::World(const WorldSettings<D>& settings, const Walls<D>& walls)
       neighbours_(settings.skin) {
   if (walls_.mill) walls_.mill->turn_to(walls_.mill->angle);
   neighbours_.set_period(axial_period());
+  set_avx2_lanes(true);
+}
+
+template <int D>
+void World<D>::set_avx2_lanes(bool on) {
+  avx2_lanes_ = on && processor_has_avx2();
 }
 
 template <int D>
@@ -454,18 +474,7 @@ void World<D>::evaluate_pair_contacts() {
       listed[count] = static_cast<std::uint32_t>(q);
       count += overlaps | touched;
     }
-    for (std::size_t k = 0; k < count; ++k) {
-      const std::size_t q = listed[k];
-      PairForce f;
-      const PairOutcome outcome = evaluate(q, f);
-      if (outcome.status == PairStatus::ended) {
-        pair_ended_[begin + ended++] = {ContactType::ball_ball, outcome.energy};
-      } else if (outcome.status == PairStatus::touching) {
-        add_to_first(q, f);
-        add_to_second(q, f);
-        dissipated += outcome.energy;
-      }
-    }
+    evaluate_listed_pairs(b, listed.data(), count, dissipated, ended);
     pair_block_dissipated_[b] = dissipated;
     pair_block_ended_[b] = ended;
   };
@@ -569,6 +578,149 @@ void World<D>::evaluate_pair_contacts() {
   last_step_dissipation_ = 0.0;
   for (const double d : pair_block_dissipated_) last_step_dissipation_ += d;
   record_ended(pair_ended_, pair_block_ended_, pair_block);
+}
+
+template <int D>
+void World<D>::evaluate_listed_pairs(std::size_t block, const std::uint32_t* listed,
+                                     std::size_t count, double& dissipated, std::uint32_t& ended) {
+#if defined(__x86_64__)
+  if (avx2_lanes_) {
+    evaluate_listed_pairs_avx2(block, listed, count, dissipated, ended);
+    return;
+  }
+#endif
+  evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended);
+}
+
+#if defined(__x86_64__)
+template <int D>
+void World<D>::evaluate_listed_pairs_avx2(std::size_t block, const std::uint32_t* listed,
+                                          std::size_t count, double& dissipated,
+                                          std::uint32_t& ended) {
+  evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended);
+}
+#endif
+
+template <int D>
+void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint32_t* listed,
+                                              std::size_t count, double& dissipated,
+                                              std::uint32_t& ended) {
+  using T = Lanes;
+  constexpr auto lanes = static_cast<std::size_t>(lane_count);
+  const auto& first = neighbours_.first();
+  const auto& second = neighbours_.second();
+  auto& history = neighbours_.history();
+  auto& touching = neighbours_.touching();
+  const auto& x = particles_.position;
+  const auto& v = velocity_now_;
+  const auto& w = spin_now_;
+  const auto& step_v = particles_.velocity;
+  const auto& step_w = particles_.angular_velocity;
+  const auto& r = particles_.radius;
+  const auto& m = particles_.mass;
+  auto& force = particles_.force;
+  auto& torque = particles_.torque;
+  const double dt = settings_.time_step;
+  const std::size_t begin = block * pair_block;
+
+  for (std::size_t k = 0; k < count; k += lanes) {
+    // The pairs of the lanes; where fewer remain, the last one fills the rest.
+    std::array<std::uint32_t, lanes> q{}, i{}, j{};
+    const std::size_t filled = std::min(lanes, count - k);
+    for (std::size_t l = 0; l < lanes; ++l) {
+      q[l] = listed[k + std::min(l, filled - 1)];
+      i[l] = first[q[l]];
+      j[l] = second[q[l]];
+    }
+    // Lanes of a number per pair: gather(f) holds f(l) in lane l.
+    const auto gather = [&](auto f) __attribute__((always_inline))->T {
+      return [&]<std::size_t... L>(std::index_sequence<L...>) __attribute__((always_inline)) {
+        return T{f(L)...};
+      }
+      (std::make_index_sequence<lanes>{});
+    };
+    std::array<Vec<D>, lanes> offset;
+    for (std::size_t l = 0; l < lanes; ++l) offset[l] = neighbours_.separation(x[i[l]], x[j[l]]);
+    Vec<D, T> separation;
+    Vec<D, T> velocity, step_velocity;
+    for (int d = 0; d < D; ++d) {
+      separation[d] = gather([&](std::size_t l) { return offset[l][d]; });
+      velocity[d] = gather([&](std::size_t l) { return v[j[l]][d] - v[i[l]][d]; });
+      step_velocity[d] = gather([&](std::size_t l) { return step_v[j[l]][d] - step_v[i[l]][d]; });
+    }
+    const T reach = gather([&](std::size_t l) { return r[i[l]] + r[j[l]]; });
+    const T distance_squared = norm_squared(separation);
+    const Mask<T> overlaps = distance_squared < reach * reach;
+    const T distance = lane_sqrt(distance_squared);
+    ContactInput<D, T> in;
+    in.normal = separation * (splat<T>(1.0) / distance);
+    in.overlap = reach - distance;
+    in.velocity = velocity;
+    in.step_velocity = step_velocity;
+    // r_i ω_i + r_j ω_j, at the time of the positions and over the last step.
+    if constexpr (D == 2) {
+      const T spin = gather([&](std::size_t l) { return r[i[l]] * w[i[l]] + r[j[l]] * w[j[l]]; });
+      const T step_spin =
+          gather([&](std::size_t l) { return r[i[l]] * step_w[i[l]] + r[j[l]] * step_w[j[l]]; });
+      in.spin_velocity = cross(in.normal, spin);
+      in.step_spin_velocity = cross(in.normal, step_spin);
+    } else {
+      Vec<3, T> spin, step_spin;
+      for (int d = 0; d < 3; ++d) {
+        spin[d] =
+            gather([&](std::size_t l) { return r[i[l]] * w[i[l]][d] + r[j[l]] * w[j[l]][d]; });
+        step_spin[d] = gather(
+            [&](std::size_t l) { return r[i[l]] * step_w[i[l]][d] + r[j[l]] * step_w[j[l]][d]; });
+      }
+      in.spin_velocity = cross(in.normal, spin);
+      in.step_spin_velocity = cross(in.normal, step_spin);
+    }
+    const T mass_i = gather([&](std::size_t l) { return m[i[l]]; });
+    const T mass_j = gather([&](std::size_t l) { return m[j[l]]; });
+    ContactHistory<D, T> held;
+    held.normal_spring_origin =
+        gather([&](std::size_t l) { return history[q[l]].normal_spring_origin; });
+    for (int d = 0; d < D; ++d) {
+      held.tangential_spring[d] =
+          gather([&](std::size_t l) { return history[q[l]].tangential_spring[d]; });
+    }
+    held.dissipated = gather([&](std::size_t l) { return history[q[l]].dissipated; });
+    const ContactDampingOf<T> damping = ball_ball_law_.damping(mass_i * mass_j / (mass_i + mass_j));
+    const ContactOutput<D, T> out = ball_ball_law_.evaluate(in, damping, held, dt);
+    const auto moment = -cross(in.normal, out.tangential_force);
+
+    // Each pair's outcome, in pair order: a pair that no longer overlaps has ended (it is
+    // listed, so it touched until now); the others add their forces.
+    for (std::size_t l = 0; l < filled; ++l) {
+      const std::uint32_t p = q[l];
+      if (overlaps[l] == 0) {
+        pair_ended_[begin + ended++] = {ContactType::ball_ball, history[p].dissipated};
+        history[p] = ContactHistory<D>{};
+        touching[p] = TouchState::apart;
+        continue;
+      }
+      touching[p] = TouchState::touching;
+      ContactHistory<D>& h = history[p];
+      h.normal_spring_origin = held.normal_spring_origin[l];
+      for (int d = 0; d < D; ++d) h.tangential_spring[d] = held.tangential_spring[d][l];
+      h.dissipated = held.dissipated[l];
+      h.overlap = in.overlap[l];
+      Vec<D> f;
+      for (int d = 0; d < D; ++d) f[d] = out.force[d][l];
+      force[i[l]] -= f;
+      force[j[l]] += f;
+      if constexpr (D == 2) {
+        torque[i[l]] += r[i[l]] * moment[l];
+        torque[j[l]] += r[j[l]] * moment[l];
+      } else {
+        Vec3 turn;
+        for (int d = 0; d < 3; ++d) turn[d] = moment[d][l];
+        torque[i[l]] += r[i[l]] * turn;
+        torque[j[l]] += r[j[l]] * turn;
+      }
+      dissipated += out.dissipated[l];
+    }
+  }
 }
 
 template <int D>

@@ -94,6 +94,11 @@ class World {
     nearby_lifter_lists_ = on;
     nearby_lifters_.clear();
   }
+  /// Whether the pair stage's lanes (core/lanes.hpp) use AVX2 instructions, as they do by
+  /// default where the processor has them; off, the instructions of any x86-64 processor. The
+  /// results are the same bit for bit either way; tests switch it off to show that.
+  void set_avx2_lanes(bool on);
+  bool avx2_lanes() const { return avx2_lanes_; }
   /// How often the lists of nearby lifters were made, at rebuilds and because the mill had
   /// turned too far since.
   long nearby_lifter_refreshes() const { return nearby_lifter_refreshes_; }
@@ -133,6 +138,25 @@ class World {
   double choose_skin() const;
   void estimate_current_velocities();
   void evaluate_pair_contacts();
+  /// The pairs of block `block` listed in `listed` (those that overlap or did until now), in
+  /// pair order, lane_count at a time (core/lanes.hpp): their contacts are worked out side by
+  /// side, then each pair's outcome applied in pair order as one at a time would. Adds the
+  /// pairs' dissipation to `dissipated` and lists the collisions that end. Compiled twice, for
+  /// processors with AVX2 and for any x86-64; the same bits either way.
+  void evaluate_listed_pairs(std::size_t block, const std::uint32_t* listed, std::size_t count,
+                             double& dissipated, std::uint32_t& ended);
+#if defined(__x86_64__)
+  __attribute__((target("avx2"))) void evaluate_listed_pairs_avx2(std::size_t block,
+                                                                  const std::uint32_t* listed,
+                                                                  std::size_t count,
+                                                                  double& dissipated,
+                                                                  std::uint32_t& ended);
+#endif
+  [[gnu::always_inline]] inline void evaluate_listed_pairs_in_lanes(std::size_t block,
+                                                                    const std::uint32_t* listed,
+                                                                    std::size_t count,
+                                                                    double& dissipated,
+                                                                    std::uint32_t& ended);
   void split_pairs_among(int threads);
   /// Whether the pair stage runs on several threads; if so, makes sure its split of particles
   /// and pairs among them (split_pairs_among) is that of the current list and thread count.
@@ -227,6 +251,7 @@ class World {
   // have moved lifter_travel_ (arc length at the shell) since they were listed, at mill angle
   // nearby_lifter_angle_ (refresh_nearby_lifters).
   bool nearby_lifter_lists_ = true;
+  bool avx2_lanes_ = false;
   std::vector<NearbyLifters> nearby_lifters_;
   double nearby_lifter_angle_ = 0.0;
   double lifter_travel_ = 0.0;
