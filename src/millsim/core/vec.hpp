@@ -3,7 +3,9 @@
 // Vec<D> is a plain aggregate of D doubles; Spin<D> is the type of an angular velocity or a
 // torque: a scalar about the out-of-plane axis in 2D, a vector in 3D. Vec<D, T> holds D of
 // some other number type: the contact law also runs on Lanes (core/lanes.hpp), several
-// contacts at once, with the same arithmetic.
+// contacts at once, with the same arithmetic. What takes or gives a T by value is always
+// inlined: a Lanes value is passed in AVX registers by code compiled for AVX2 and in memory by
+// the rest, so it must never cross a call between the two (unoptimised builds included).
 #pragma once
 
 #include <array>
@@ -17,26 +19,26 @@ struct Vec {
   static_assert(D == 2 || D == 3, "millsim works in two or three dimensions");
   std::array<T, D> c{};
 
-  constexpr T& operator[](int i) { return c[static_cast<std::size_t>(i)]; }
-  constexpr T operator[](int i) const { return c[static_cast<std::size_t>(i)]; }
+  [[gnu::always_inline]] constexpr T& operator[](int i) { return c[static_cast<std::size_t>(i)]; }
+  [[gnu::always_inline]] constexpr T operator[](int i) const { return c[static_cast<std::size_t>(i)]; }
 
-  constexpr Vec& operator+=(const Vec& o) {
+  [[gnu::always_inline]] constexpr Vec& operator+=(const Vec& o) {
     for (int i = 0; i < D; ++i) (*this)[i] += o[i];
     return *this;
   }
-  constexpr Vec& operator-=(const Vec& o) {
+  [[gnu::always_inline]] constexpr Vec& operator-=(const Vec& o) {
     for (int i = 0; i < D; ++i) (*this)[i] -= o[i];
     return *this;
   }
-  constexpr Vec& operator*=(T s) {
+  [[gnu::always_inline]] constexpr Vec& operator*=(T s) {
     for (int i = 0; i < D; ++i) (*this)[i] *= s;
     return *this;
   }
-  friend constexpr Vec operator+(Vec a, const Vec& b) { return a += b; }
-  friend constexpr Vec operator-(Vec a, const Vec& b) { return a -= b; }
-  friend constexpr Vec operator*(Vec a, T s) { return a *= s; }
-  friend constexpr Vec operator*(T s, Vec a) { return a *= s; }
-  friend constexpr Vec operator-(Vec a) {
+  [[gnu::always_inline]] friend constexpr Vec operator+(Vec a, const Vec& b) { return a += b; }
+  [[gnu::always_inline]] friend constexpr Vec operator-(Vec a, const Vec& b) { return a -= b; }
+  [[gnu::always_inline]] friend constexpr Vec operator*(Vec a, T s) { return a *= s; }
+  [[gnu::always_inline]] friend constexpr Vec operator*(T s, Vec a) { return a *= s; }
+  [[gnu::always_inline]] friend constexpr Vec operator-(Vec a) {
     for (int i = 0; i < D; ++i) a[i] = -a[i];
     return a;
   }
@@ -47,13 +49,13 @@ using Vec2 = Vec<2>;
 using Vec3 = Vec<3>;
 
 template <int D, class T>
-constexpr T dot(const Vec<D, T>& a, const Vec<D, T>& b) {
+[[gnu::always_inline]] constexpr T dot(const Vec<D, T>& a, const Vec<D, T>& b) {
   T s{};
   for (int i = 0; i < D; ++i) s += a[i] * b[i];
   return s;
 }
 template <int D, class T>
-constexpr T norm_squared(const Vec<D, T>& a) {
+[[gnu::always_inline]] constexpr T norm_squared(const Vec<D, T>& a) {
   return dot(a, a);
 }
 template <int D>
@@ -67,7 +69,7 @@ using Spin = std::conditional_t<D == 2, double, Vec3>;
 
 /// n × s for a vector n and a spin s. In 2D s is along +z: (n_x, n_y, 0) × (0, 0, s).
 template <class T>
-constexpr Vec<2, T> cross(const Vec<2, T>& n, T s) {
+[[gnu::always_inline]] constexpr Vec<2, T> cross(const Vec<2, T>& n, T s) {
   return Vec<2, T>{{n[1] * s, -n[0] * s}};
 }
 /// s × r for a spin s along +z and a vector r in the plane: the velocity of a point at r.
@@ -76,12 +78,12 @@ inline constexpr Vec2 cross(double s, const Vec2& r) {
 }
 /// a × b for two plane vectors: the z component.
 template <class T>
-constexpr T cross(const Vec<2, T>& a, const Vec<2, T>& b) {
+[[gnu::always_inline]] constexpr T cross(const Vec<2, T>& a, const Vec<2, T>& b) {
   return a[0] * b[1] - a[1] * b[0];
 }
 
 template <class T>
-constexpr Vec<3, T> cross(const Vec<3, T>& a, const Vec<3, T>& b) {
+[[gnu::always_inline]] constexpr Vec<3, T> cross(const Vec<3, T>& a, const Vec<3, T>& b) {
   return Vec<3, T>{
       {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
 }
