@@ -737,18 +737,23 @@ void World<D>::evaluate_wall_contacts() {
     double dissipated = 0.0;
     std::uint32_t ended = 0;
     EndedCollision* block_ended = &wall_ended_[b * wall_block * max_wall_contacts];
-    const std::size_t end = std::min(candidates, (b + 1) * wall_block);
-    for (std::size_t k = b * wall_block; k < end; ++k) {
-      const std::size_t i = wall_candidates_[k];
+    const std::size_t begin = b * wall_block;
+    const std::size_t end = std::min(candidates, begin + wall_block);
+    // The block's contacts, found candidate by candidate (each in its slot of wall-contact
+    // history), then their contact law worked out lane_count at a time, then each candidate's
+    // contacts added up in the order they were found. One list per thread, kept.
+    static thread_local std::vector<WallWork> work_list;
+    static thread_local std::vector<std::uint32_t> first_work;
+    work_list.clear();
+    first_work.assign(end - begin + 1, 0);
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::uint32_t i = wall_candidates_[k];
       std::int32_t* slot_id = &wall_slot_id_[k * max_wall_contacts];
-      ContactHistory<D>* slot_history = &wall_slot_history_[k * max_wall_contacts];
+      const ContactHistory<D>* slot_history = &wall_slot_history_[k * max_wall_contacts];
       std::array<bool, max_wall_contacts> seen{};
-      Vec<D> force{};
-      Spin<D> moment{};
-      const double radius = particles_.radius[i];
       const NearbyLifters* nearby = nearby_lifters_.empty() ? nullptr : &nearby_lifters_[k];
       walls_.for_each_contact(
-          particles_.position[i], radius,
+          particles_.position[i], particles_.radius[i],
           [&](const WallContact<D>& contact) {
             int slot = 0;
             while (slot < max_wall_contacts && slot_id[slot] != contact.wall_id) ++slot;
@@ -759,31 +764,40 @@ void World<D>::evaluate_wall_contacts() {
               slot_id[slot] = contact.wall_id;
             }
             seen[static_cast<std::size_t>(slot)] = true;
-            ContactInput<D> in;
-            in.normal = contact.normal;
-            in.overlap = contact.overlap;
-            in.velocity = velocity_now_[i] - contact.wall_velocity;
-            in.spin_velocity = cross(contact.normal, radius * spin_now_[i]);
-            in.step_velocity = particles_.velocity[i] - contact.wall_velocity;
-            in.step_spin_velocity = cross(contact.normal, radius * particles_.angular_velocity[i]);
-            ContactHistory<D>& history = slot_history[slot];
-            history.overlap = contact.overlap;
-            const ContactOutput<D> out = ball_wall_law_.evaluate(in, wall_damping_[i], history, dt);
-            force += out.force;
-            moment += -radius * cross(contact.normal, out.tangential_force);
-            dissipated += out.dissipated;
-            if (contact.kind != WallKind::plane) {
-              torque += axial_moment(contact.point, out.force);
-              work += dot(out.force, contact.wall_velocity) * dt;
-            }
+            WallWork found;
+            found.particle = i;
+            found.slot = static_cast<std::uint32_t>(k * max_wall_contacts) +
+                         static_cast<std::uint32_t>(slot);
+            found.contact = contact;
+            work_list.push_back(found);
           },
           nearby);
+      first_work[k - begin + 1] = static_cast<std::uint32_t>(work_list.size());
+      // Slots of walls the candidate no longer touches: their collisions have ended. (The law
+      // below works on the touched slots alone.)
       for (int slot = 0; slot < max_wall_contacts; ++slot) {
         if (slot_id[slot] < 0 || seen[static_cast<std::size_t>(slot)]) continue;
         block_ended[ended++] = {wall_contact_type(walls_.kind_of(slot_id[slot])),
                                 slot_history[slot].dissipated};
-        slot_history[slot] = ContactHistory<D>{};
+        wall_slot_history_[k * max_wall_contacts + static_cast<std::size_t>(slot)] =
+            ContactHistory<D>{};
         slot_id[slot] = -1;
+      }
+    }
+    evaluate_wall_laws(work_list.data(), work_list.size());
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::uint32_t i = wall_candidates_[k];
+      Vec<D> force{};
+      Spin<D> moment{};
+      for (std::uint32_t w = first_work[k - begin]; w < first_work[k - begin + 1]; ++w) {
+        const WallWork& done = work_list[w];
+        force += done.force;
+        moment += done.moment;
+        dissipated += done.dissipated;
+        if (done.contact.kind != WallKind::plane) {
+          torque += axial_moment(done.contact.point, done.force);
+          work += dot(done.force, done.contact.wall_velocity) * dt;
+        }
       }
       // Added to the particle's sums after its pairs (the pair stage is done), before gravity.
       particles_.force[i] += force;
@@ -803,6 +817,109 @@ void World<D>::evaluate_wall_contacts() {
   shell_torque_ = torque;
   account_.dissipated += last_step_dissipation_;
   record_ended(wall_ended_, wall_block_ended_, wall_block * max_wall_contacts);
+}
+
+template <int D>
+void World<D>::evaluate_wall_laws(WallWork* work, std::size_t count) {
+#if defined(__x86_64__)
+  if (avx2_lanes_) {
+    evaluate_wall_laws_avx2(work, count);
+    return;
+  }
+#endif
+  evaluate_wall_laws_in_lanes(work, count);
+}
+
+#if defined(__x86_64__)
+template <int D>
+void World<D>::evaluate_wall_laws_avx2(WallWork* work, std::size_t count) {
+  evaluate_wall_laws_in_lanes(work, count);
+}
+#endif
+
+template <int D>
+void World<D>::evaluate_wall_laws_in_lanes(WallWork* work, std::size_t count) {
+  using T = Lanes;
+  constexpr auto lanes = static_cast<std::size_t>(lane_count);
+  const double dt = settings_.time_step;
+  const auto& p = particles_;
+  for (std::size_t k = 0; k < count; k += lanes) {
+    // The contacts of the lanes; where fewer remain, the last one fills the rest.
+    const std::size_t filled = std::min(lanes, count - k);
+    std::array<WallWork*, lanes> c{};
+    for (std::size_t l = 0; l < lanes; ++l) c[l] = &work[k + std::min(l, filled - 1)];
+    const auto gather = [&](auto f) __attribute__((always_inline))->T {
+      return [&]<std::size_t... L>(std::index_sequence<L...>) __attribute__((always_inline)) {
+        return T{f(L)...};
+      }
+      (std::make_index_sequence<lanes>{});
+    };
+    const auto particle = [&](std::size_t l) { return c[l]->particle; };
+    ContactInput<D, T> in;
+    for (int d = 0; d < D; ++d) {
+      in.normal[d] = gather([&](std::size_t l) { return c[l]->contact.normal[d]; });
+      in.velocity[d] = gather([&](std::size_t l) {
+        return velocity_now_[particle(l)][d] - c[l]->contact.wall_velocity[d];
+      });
+      in.step_velocity[d] = gather([&](std::size_t l) {
+        return p.velocity[particle(l)][d] - c[l]->contact.wall_velocity[d];
+      });
+    }
+    in.overlap = gather([&](std::size_t l) { return c[l]->contact.overlap; });
+    const T radius = gather([&](std::size_t l) { return p.radius[particle(l)]; });
+    // r ω at the time of the positions and over the last step.
+    if constexpr (D == 2) {
+      const T spin =
+          gather([&](std::size_t l) { return p.radius[particle(l)] * spin_now_[particle(l)]; });
+      const T step_spin = gather(
+          [&](std::size_t l) { return p.radius[particle(l)] * p.angular_velocity[particle(l)]; });
+      in.spin_velocity = cross(in.normal, spin);
+      in.step_spin_velocity = cross(in.normal, step_spin);
+    } else {
+      Vec<3, T> spin, step_spin;
+      for (int d = 0; d < 3; ++d) {
+        spin[d] = gather(
+            [&](std::size_t l) { return p.radius[particle(l)] * spin_now_[particle(l)][d]; });
+        step_spin[d] = gather([&](std::size_t l) {
+          return p.radius[particle(l)] * p.angular_velocity[particle(l)][d];
+        });
+      }
+      in.spin_velocity = cross(in.normal, spin);
+      in.step_spin_velocity = cross(in.normal, step_spin);
+    }
+    ContactDampingOf<T> damping;
+    damping.normal = gather([&](std::size_t l) { return wall_damping_[particle(l)].normal; });
+    damping.tangential =
+        gather([&](std::size_t l) { return wall_damping_[particle(l)].tangential; });
+    ContactHistory<D, T> held;
+    const auto history = [&](std::size_t l) -> ContactHistory<D>& {
+      return wall_slot_history_[c[l]->slot];
+    };
+    held.normal_spring_origin =
+        gather([&](std::size_t l) { return history(l).normal_spring_origin; });
+    for (int d = 0; d < D; ++d) {
+      held.tangential_spring[d] =
+          gather([&](std::size_t l) { return history(l).tangential_spring[d]; });
+    }
+    held.dissipated = gather([&](std::size_t l) { return history(l).dissipated; });
+    const ContactOutput<D, T> out = ball_wall_law_.evaluate(in, damping, held, dt);
+    const auto moment = -radius * cross(in.normal, out.tangential_force);
+    for (std::size_t l = 0; l < filled; ++l) {
+      ContactHistory<D>& h = history(l);
+      h.normal_spring_origin = held.normal_spring_origin[l];
+      for (int d = 0; d < D; ++d) h.tangential_spring[d] = held.tangential_spring[d][l];
+      h.dissipated = held.dissipated[l];
+      h.overlap = in.overlap[l];
+      WallWork& done = *c[l];
+      for (int d = 0; d < D; ++d) done.force[d] = out.force[d][l];
+      if constexpr (D == 2) {
+        done.moment = moment[l];
+      } else {
+        for (int d = 0; d < 3; ++d) done.moment[d] = moment[d][l];
+      }
+      done.dissipated = out.dissipated[l];
+    }
+  }
 }
 
 template <int D>

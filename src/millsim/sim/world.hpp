@@ -166,6 +166,23 @@ class World {
   /// on one thread, or split evenly if there are many particles but few pairs.
   template <class Body>
   void for_each_particle(Body&& body);
+  /// A wall contact of a candidate: where its history is, and what the contact law made of it.
+  struct WallWork {
+    std::uint32_t particle = 0;
+    std::uint32_t slot = 0;  ///< in wall_slot_history_
+    WallContact<D> contact;
+    Vec<D> force{};
+    Spin<D> moment{};  ///< −r n × F_t
+    double dissipated = 0.0;
+  };
+  /// The contact law of `count` wall contacts, lane_count at a time (core/lanes.hpp): each
+  /// contact's force, moment and dissipation, and its history updated. Compiled twice, as
+  /// evaluate_listed_pairs is; the same bits as the law on one contact.
+  void evaluate_wall_laws(WallWork* work, std::size_t count);
+#if defined(__x86_64__)
+  __attribute__((target("avx2"))) void evaluate_wall_laws_avx2(WallWork* work, std::size_t count);
+#endif
+  [[gnu::always_inline]] inline void evaluate_wall_laws_in_lanes(WallWork* work, std::size_t count);
   void refresh_nearby_lifters();
   bool lifters_moved_too_far() const;
   void evaluate_wall_contacts();
