@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <random>
@@ -100,6 +101,68 @@ TEST(NeighbourList, DiscPairsEqualBruteForceSortedByFirstThenSecond) {
 
 TEST(NeighbourList, SpherePairsEqualBruteForceSortedByFirstThenSecond) {
   for (std::uint64_t seed : {1u, 2u, 3u}) check_matches_brute_force<3>(seed);
+}
+
+/// Every pair i < j closer than r_i + r_j + list_skin, along the last axis by the nearest image
+/// when `period` > 0.
+template <int D>
+PairList brute_force_pairs_periodic(const Cloud<D>& cloud, double list_skin, double period) {
+  PairList pairs;
+  for (std::uint32_t i = 0; i < cloud.position.size(); ++i) {
+    for (std::uint32_t j = i + 1; j < cloud.position.size(); ++j) {
+      Vec<D> offset = cloud.position[j] - cloud.position[i];
+      if (period > 0.0) offset[D - 1] -= period * std::nearbyint(offset[D - 1] / period);
+      const double reach = cloud.radius[i] + cloud.radius[j] + list_skin;
+      if (norm_squared(offset) < reach * reach) pairs.emplace_back(i, j);
+    }
+  }
+  return pairs;
+}
+
+/// Particles of a few sizes, many of each (as a mill's charge): two particles of the same radius
+/// are found from one of them only, the one earlier in the cells' order, and a particle of the
+/// smallest radius searches only the cells after its own. The list is the brute force's, in
+/// the particles' own numbering and after renumbering into cell order, and with the last axis
+/// periodic (pairs across the ends found once).
+template <int D>
+void check_equal_radii(const std::vector<double>& sizes, double period) {
+  for (std::uint64_t seed : {4u, 5u}) {
+    Cloud<D> cloud = random_cloud<D>(cloud_size, box_side<D>, seed);
+    std::mt19937_64 random(seed);
+    std::uniform_int_distribution<std::size_t> pick(0, sizes.size() - 1);
+    for (double& r : cloud.radius) r = sizes[pick(random)];
+    NeighbourList<D> list(skin);
+    list.set_period(period);
+    list.rebuild(cloud.position, cloud.radius);
+    const PairList expected = brute_force_pairs_periodic(cloud, skin, period);
+    ASSERT_GT(expected.size(), cloud_size);
+    EXPECT_EQ(listed_pairs(list), expected);
+
+    // Renumbered into cell order: the same pairs among the renumbered particles.
+    list.rebuild(cloud.position, cloud.radius, true);
+    Cloud<D> renumbered;
+    for (const std::uint32_t before : list.previous_index()) {
+      renumbered.position.push_back(cloud.position[before]);
+      renumbered.radius.push_back(cloud.radius[before]);
+    }
+    EXPECT_EQ(listed_pairs(list), brute_force_pairs_periodic(renumbered, skin, period));
+  }
+}
+
+TEST(NeighbourList, OneSizeOfParticleMatchesBruteForce) {
+  check_equal_radii<2>({1.0}, 0.0);
+  check_equal_radii<3>({1.0}, 0.0);
+}
+
+TEST(NeighbourList, AFewSizesOfParticleMatchBruteForce) {
+  check_equal_radii<2>({0.5, 1.0, 1.5}, 0.0);
+  check_equal_radii<3>({0.5, 1.0, 1.5}, 0.0);
+}
+
+TEST(NeighbourList, PeriodicAxisMatchesBruteForceByTheNearestImage) {
+  // The box's side along the last axis is the period; positions lie in [0, period).
+  check_equal_radii<2>({1.0}, box_side<2>);
+  check_equal_radii<3>({0.5, 1.0, 1.5}, box_side<3>);
 }
 
 TEST(NeighbourList, WideSpreadCloudStillMatchesBruteForce) {

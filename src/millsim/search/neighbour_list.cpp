@@ -47,9 +47,10 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
   if (count > 0) {
     // Cells of side the smallest cut-off distance (two of the smallest particles), grown if
     // the particles are spread so wide that the grid would hold many more cells than
-    // particles. Each pair is found once, from its larger particle (ties: from the lower
-    // index), which searches as many cells round its own as its largest cut-off needs: a
-    // small particle looks only at its neighbouring cells however large the largest one is.
+    // particles. Each pair is found once, from its larger particle (ties: from the one earlier
+    // in the cells' order, below), which searches as many cells round its own as its largest
+    // cut-off needs: a small particle looks only at its neighbouring cells however large the
+    // largest one is.
     const auto [smallest, largest] = std::minmax_element(radius.begin(), radius.end());
     Vec<D> low = position[0];
     Vec<D> high = position[0];
@@ -120,11 +121,18 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       }
     }
 
-    // Pairs found from the particle in `slot` (see above) go to `found`.
+    // Pairs found from the particle in `slot` (see above) go to `found`. Two particles of the
+    // same radius: from the one in the earlier slot (cells in order, each cell's members in
+    // order). A particle of the smallest radius, then, has nothing to find in the slots up to
+    // its own: all it can find is another of its radius in a later slot, and it looks at those
+    // alone (half the search in a mill of one ball size).
+    const double smallest_radius = *smallest;
     const auto search_from = [&](std::size_t slot,
                                  std::vector<std::pair<std::uint32_t, std::uint32_t>>& found) {
       const std::uint32_t i = cell_members_[slot];
       const double own_radius = cell_radius_[slot];
+      const std::uint32_t first_slot =
+          own_radius == smallest_radius ? static_cast<std::uint32_t>(slot + 1) : 0;
       const Vec<D> own_position = cell_position_[slot];
       const std::array<long, D>& own_home = home[into_cell_order ? previous_index_[slot] : i];
       const double cutoff = 2.0 * own_radius + skin_;  // the farthest a smaller partner can be
@@ -145,13 +153,14 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       // Cells along axis 0 are contiguous in the cell order, so each row of the range is one
       // run of cell_members_ (axis 0 is never periodic).
       const auto visit_row = [&](std::size_t row) {
-        const std::uint32_t begin = cell_start_[row + static_cast<std::size_t>(from[0])];
+        const std::uint32_t begin =
+            std::max(first_slot, cell_start_[row + static_cast<std::size_t>(from[0])]);
         const std::uint32_t end = cell_start_[row + static_cast<std::size_t>(to[0]) + 1];
         for (std::uint32_t k = begin; k < end; ++k) {
           const double other_radius = cell_radius_[k];
           if (other_radius > own_radius) continue;
+          if (other_radius == own_radius && k <= slot) continue;
           const std::uint32_t j = cell_members_[k];
-          if (other_radius == own_radius && j <= i) continue;
           const double reach = own_radius + other_radius + skin_;
           if (norm_squared(separation(own_position, cell_position_[k])) < reach * reach) {
             found.push_back(i < j ? std::pair{i, j} : std::pair{j, i});
@@ -163,7 +172,9 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       };
       const auto width = static_cast<std::size_t>(cells[0]);
       if constexpr (D == 2) {
-        for (long y = from[1]; y <= to[1]; ++y) visit_row(static_cast<std::size_t>(y) * width);
+        for (long y = from[1]; y <= to[1]; ++y) {
+          visit_row(static_cast<std::size_t>(wrap(y, 1)) * width);
+        }
       } else {
         for (long z = from[2]; z <= to[2]; ++z) {
           const auto plane =
