@@ -607,19 +607,14 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
                                               std::uint32_t& ended) {
   using T = Lanes;
   constexpr auto lanes = static_cast<std::size_t>(lane_count);
-  const auto& first = neighbours_.first();
-  const auto& second = neighbours_.second();
-  auto& history = neighbours_.history();
-  auto& touching = neighbours_.touching();
-  const auto& x = particles_.position;
+  // The particles' arrays the step reads, by the names the law uses: v and ω at the time of the
+  // positions, and over the last step.
+  const auto& p = particles_;
   const auto& v = velocity_now_;
   const auto& w = spin_now_;
-  const auto& step_v = particles_.velocity;
-  const auto& step_w = particles_.angular_velocity;
   const auto& r = particles_.radius;
-  const auto& m = particles_.mass;
-  auto& force = particles_.force;
-  auto& torque = particles_.torque;
+  auto& history = neighbours_.history();
+  auto& touching = neighbours_.touching();
   const double dt = settings_.time_step;
   const std::size_t begin = block * pair_block;
 
@@ -629,8 +624,8 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
     const std::size_t filled = std::min(lanes, count - k);
     for (std::size_t l = 0; l < lanes; ++l) {
       q[l] = listed[k + std::min(l, filled - 1)];
-      i[l] = first[q[l]];
-      j[l] = second[q[l]];
+      i[l] = neighbours_.first()[q[l]];
+      j[l] = neighbours_.second()[q[l]];
     }
     // Lanes of a number per pair: gather(f) holds f(l) in lane l.
     const auto gather = [&](auto f) __attribute__((always_inline))->T {
@@ -640,13 +635,15 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
       (std::make_index_sequence<lanes>{});
     };
     std::array<Vec<D>, lanes> offset;
-    for (std::size_t l = 0; l < lanes; ++l) offset[l] = neighbours_.separation(x[i[l]], x[j[l]]);
+    for (std::size_t l = 0; l < lanes; ++l)
+      offset[l] = neighbours_.separation(p.position[i[l]], p.position[j[l]]);
     Vec<D, T> separation;
     Vec<D, T> velocity, step_velocity;
     for (int d = 0; d < D; ++d) {
       separation[d] = gather([&](std::size_t l) { return offset[l][d]; });
       velocity[d] = gather([&](std::size_t l) { return v[j[l]][d] - v[i[l]][d]; });
-      step_velocity[d] = gather([&](std::size_t l) { return step_v[j[l]][d] - step_v[i[l]][d]; });
+      step_velocity[d] =
+          gather([&](std::size_t l) { return p.velocity[j[l]][d] - p.velocity[i[l]][d]; });
     }
     const T reach = gather([&](std::size_t l) { return r[i[l]] + r[j[l]]; });
     const T distance_squared = norm_squared(separation);
@@ -660,8 +657,9 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
     // r_i ω_i + r_j ω_j, at the time of the positions and over the last step.
     if constexpr (D == 2) {
       const T spin = gather([&](std::size_t l) { return r[i[l]] * w[i[l]] + r[j[l]] * w[j[l]]; });
-      const T step_spin =
-          gather([&](std::size_t l) { return r[i[l]] * step_w[i[l]] + r[j[l]] * step_w[j[l]]; });
+      const T step_spin = gather([&](std::size_t l) {
+        return r[i[l]] * p.angular_velocity[i[l]] + r[j[l]] * p.angular_velocity[j[l]];
+      });
       in.spin_velocity = cross(in.normal, spin);
       in.step_spin_velocity = cross(in.normal, step_spin);
     } else {
@@ -669,14 +667,15 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
       for (int d = 0; d < 3; ++d) {
         spin[d] =
             gather([&](std::size_t l) { return r[i[l]] * w[i[l]][d] + r[j[l]] * w[j[l]][d]; });
-        step_spin[d] = gather(
-            [&](std::size_t l) { return r[i[l]] * step_w[i[l]][d] + r[j[l]] * step_w[j[l]][d]; });
+        step_spin[d] = gather([&](std::size_t l) {
+          return r[i[l]] * p.angular_velocity[i[l]][d] + r[j[l]] * p.angular_velocity[j[l]][d];
+        });
       }
       in.spin_velocity = cross(in.normal, spin);
       in.step_spin_velocity = cross(in.normal, step_spin);
     }
-    const T mass_i = gather([&](std::size_t l) { return m[i[l]]; });
-    const T mass_j = gather([&](std::size_t l) { return m[j[l]]; });
+    const T mass_i = gather([&](std::size_t l) { return p.mass[i[l]]; });
+    const T mass_j = gather([&](std::size_t l) { return p.mass[j[l]]; });
     ContactHistory<D, T> held;
     held.normal_spring_origin =
         gather([&](std::size_t l) { return history[q[l]].normal_spring_origin; });
@@ -692,31 +691,31 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
     // Each pair's outcome, in pair order: a pair that no longer overlaps has ended (it is
     // listed, so it touched until now); the others add their forces.
     for (std::size_t l = 0; l < filled; ++l) {
-      const std::uint32_t p = q[l];
+      const std::uint32_t pair = q[l];
       if (overlaps[l] == 0) {
-        pair_ended_[begin + ended++] = {ContactType::ball_ball, history[p].dissipated};
-        history[p] = ContactHistory<D>{};
-        touching[p] = TouchState::apart;
+        pair_ended_[begin + ended++] = {ContactType::ball_ball, history[pair].dissipated};
+        history[pair] = ContactHistory<D>{};
+        touching[pair] = TouchState::apart;
         continue;
       }
-      touching[p] = TouchState::touching;
-      ContactHistory<D>& h = history[p];
+      touching[pair] = TouchState::touching;
+      ContactHistory<D>& h = history[pair];
       h.normal_spring_origin = held.normal_spring_origin[l];
       for (int d = 0; d < D; ++d) h.tangential_spring[d] = held.tangential_spring[d][l];
       h.dissipated = held.dissipated[l];
       h.overlap = in.overlap[l];
       Vec<D> f;
       for (int d = 0; d < D; ++d) f[d] = out.force[d][l];
-      force[i[l]] -= f;
-      force[j[l]] += f;
+      particles_.force[i[l]] -= f;
+      particles_.force[j[l]] += f;
       if constexpr (D == 2) {
-        torque[i[l]] += r[i[l]] * moment[l];
-        torque[j[l]] += r[j[l]] * moment[l];
+        particles_.torque[i[l]] += r[i[l]] * moment[l];
+        particles_.torque[j[l]] += r[j[l]] * moment[l];
       } else {
         Vec3 turn;
         for (int d = 0; d < 3; ++d) turn[d] = moment[d][l];
-        torque[i[l]] += r[i[l]] * turn;
-        torque[j[l]] += r[j[l]] * turn;
+        particles_.torque[i[l]] += r[i[l]] * turn;
+        particles_.torque[j[l]] += r[j[l]] * turn;
       }
       dissipated += out.dissipated[l];
     }
