@@ -20,7 +20,9 @@ struct Vec {
   std::array<T, D> c{};
 
   [[gnu::always_inline]] constexpr T& operator[](int i) { return c[static_cast<std::size_t>(i)]; }
-  [[gnu::always_inline]] constexpr T operator[](int i) const { return c[static_cast<std::size_t>(i)]; }
+  [[gnu::always_inline]] constexpr T operator[](int i) const {
+    return c[static_cast<std::size_t>(i)];
+  }
 
   [[gnu::always_inline]] constexpr Vec& operator+=(const Vec& o) {
     for (int i = 0; i < D; ++i) (*this)[i] += o[i];
