@@ -160,9 +160,11 @@ TEST(ContactLanes, HelpersWorkLaneByLane) {
   for (std::size_t l = 0; l < lanes; ++l) x[l] = static_cast<double>(l) - 1.5;
   const Lanes roots = lane_sqrt(lane_abs(x));
   const Lanes chosen = select(x > 0.0, x, splat<Lanes>(7.0));
+  const Lanes gathered = gather_lanes([](std::size_t l) { return 10.0 * static_cast<double>(l); });
   for (std::size_t l = 0; l < lanes; ++l) {
     EXPECT_EQ(roots[l], std::sqrt(std::abs(static_cast<double>(l) - 1.5)));
     EXPECT_EQ(chosen[l], x[l] > 0.0 ? x[l] : 7.0);
+    EXPECT_EQ(gathered[l], 10.0 * static_cast<double>(l));
   }
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <utility>
 
 #include "millsim/core/vec.hpp"
 
@@ -51,6 +52,15 @@ template <class M, int D, class T>
   Lanes r;
   for (int l = 0; l < lane_count; ++l) r[l] = __builtin_fabs(x[l]);
   return r;
+}
+
+/// Lanes holding f(l) in lane l, for l = 0 … lane_count − 1 (f gives one double per lane).
+template <class F>
+[[gnu::always_inline]] inline Lanes gather_lanes(F&& f) {
+  return [&]<std::size_t... L>(std::index_sequence<L...>) __attribute__((always_inline)) {
+    return Lanes{f(L)...};
+  }
+  (std::make_index_sequence<static_cast<std::size_t>(lane_count)>{});
 }
 
 /// The same value in every lane.

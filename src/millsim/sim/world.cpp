@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <type_traits>
-#include <utility>
 
 namespace millsim {
 namespace {
@@ -627,25 +626,18 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
       i[l] = neighbours_.first()[q[l]];
       j[l] = neighbours_.second()[q[l]];
     }
-    // Lanes of a number per pair: gather(f) holds f(l) in lane l.
-    const auto gather = [&](auto f) __attribute__((always_inline))->T {
-      return [&]<std::size_t... L>(std::index_sequence<L...>) __attribute__((always_inline)) {
-        return T{f(L)...};
-      }
-      (std::make_index_sequence<lanes>{});
-    };
     std::array<Vec<D>, lanes> offset;
     for (std::size_t l = 0; l < lanes; ++l)
       offset[l] = neighbours_.separation(p.position[i[l]], p.position[j[l]]);
     Vec<D, T> separation;
     Vec<D, T> velocity, step_velocity;
     for (int d = 0; d < D; ++d) {
-      separation[d] = gather([&](std::size_t l) { return offset[l][d]; });
-      velocity[d] = gather([&](std::size_t l) { return v[j[l]][d] - v[i[l]][d]; });
+      separation[d] = gather_lanes([&](std::size_t l) { return offset[l][d]; });
+      velocity[d] = gather_lanes([&](std::size_t l) { return v[j[l]][d] - v[i[l]][d]; });
       step_velocity[d] =
-          gather([&](std::size_t l) { return p.velocity[j[l]][d] - p.velocity[i[l]][d]; });
+          gather_lanes([&](std::size_t l) { return p.velocity[j[l]][d] - p.velocity[i[l]][d]; });
     }
-    const T reach = gather([&](std::size_t l) { return r[i[l]] + r[j[l]]; });
+    const T reach = gather_lanes([&](std::size_t l) { return r[i[l]] + r[j[l]]; });
     const T distance_squared = norm_squared(separation);
     const Mask<T> overlaps = distance_squared < reach * reach;
     const T distance = lane_sqrt(distance_squared);
@@ -656,8 +648,9 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
     in.step_velocity = step_velocity;
     // r_i ω_i + r_j ω_j, at the time of the positions and over the last step.
     if constexpr (D == 2) {
-      const T spin = gather([&](std::size_t l) { return r[i[l]] * w[i[l]] + r[j[l]] * w[j[l]]; });
-      const T step_spin = gather([&](std::size_t l) {
+      const T spin =
+          gather_lanes([&](std::size_t l) { return r[i[l]] * w[i[l]] + r[j[l]] * w[j[l]]; });
+      const T step_spin = gather_lanes([&](std::size_t l) {
         return r[i[l]] * p.angular_velocity[i[l]] + r[j[l]] * p.angular_velocity[j[l]];
       });
       in.spin_velocity = cross(in.normal, spin);
@@ -665,25 +658,25 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
     } else {
       Vec<3, T> spin, step_spin;
       for (int d = 0; d < 3; ++d) {
-        spin[d] =
-            gather([&](std::size_t l) { return r[i[l]] * w[i[l]][d] + r[j[l]] * w[j[l]][d]; });
-        step_spin[d] = gather([&](std::size_t l) {
+        spin[d] = gather_lanes(
+            [&](std::size_t l) { return r[i[l]] * w[i[l]][d] + r[j[l]] * w[j[l]][d]; });
+        step_spin[d] = gather_lanes([&](std::size_t l) {
           return r[i[l]] * p.angular_velocity[i[l]][d] + r[j[l]] * p.angular_velocity[j[l]][d];
         });
       }
       in.spin_velocity = cross(in.normal, spin);
       in.step_spin_velocity = cross(in.normal, step_spin);
     }
-    const T mass_i = gather([&](std::size_t l) { return p.mass[i[l]]; });
-    const T mass_j = gather([&](std::size_t l) { return p.mass[j[l]]; });
+    const T mass_i = gather_lanes([&](std::size_t l) { return p.mass[i[l]]; });
+    const T mass_j = gather_lanes([&](std::size_t l) { return p.mass[j[l]]; });
     ContactHistory<D, T> held;
     held.normal_spring_origin =
-        gather([&](std::size_t l) { return history[q[l]].normal_spring_origin; });
+        gather_lanes([&](std::size_t l) { return history[q[l]].normal_spring_origin; });
     for (int d = 0; d < D; ++d) {
       held.tangential_spring[d] =
-          gather([&](std::size_t l) { return history[q[l]].tangential_spring[d]; });
+          gather_lanes([&](std::size_t l) { return history[q[l]].tangential_spring[d]; });
     }
-    held.dissipated = gather([&](std::size_t l) { return history[q[l]].dissipated; });
+    held.dissipated = gather_lanes([&](std::size_t l) { return history[q[l]].dissipated; });
     const ContactDampingOf<T> damping = ball_ball_law_.damping(mass_i * mass_j / (mass_i + mass_j));
     const ContactOutput<D, T> out = ball_ball_law_.evaluate(in, damping, held, dt);
     const auto moment = -cross(in.normal, out.tangential_force);
@@ -847,39 +840,33 @@ void World<D>::evaluate_wall_laws_in_lanes(WallWork* work, std::size_t count) {
     const std::size_t filled = std::min(lanes, count - k);
     std::array<WallWork*, lanes> c{};
     for (std::size_t l = 0; l < lanes; ++l) c[l] = &work[k + std::min(l, filled - 1)];
-    const auto gather = [&](auto f) __attribute__((always_inline))->T {
-      return [&]<std::size_t... L>(std::index_sequence<L...>) __attribute__((always_inline)) {
-        return T{f(L)...};
-      }
-      (std::make_index_sequence<lanes>{});
-    };
     const auto particle = [&](std::size_t l) { return c[l]->particle; };
     ContactInput<D, T> in;
     for (int d = 0; d < D; ++d) {
-      in.normal[d] = gather([&](std::size_t l) { return c[l]->contact.normal[d]; });
-      in.velocity[d] = gather([&](std::size_t l) {
+      in.normal[d] = gather_lanes([&](std::size_t l) { return c[l]->contact.normal[d]; });
+      in.velocity[d] = gather_lanes([&](std::size_t l) {
         return velocity_now_[particle(l)][d] - c[l]->contact.wall_velocity[d];
       });
-      in.step_velocity[d] = gather([&](std::size_t l) {
+      in.step_velocity[d] = gather_lanes([&](std::size_t l) {
         return p.velocity[particle(l)][d] - c[l]->contact.wall_velocity[d];
       });
     }
-    in.overlap = gather([&](std::size_t l) { return c[l]->contact.overlap; });
-    const T radius = gather([&](std::size_t l) { return p.radius[particle(l)]; });
+    in.overlap = gather_lanes([&](std::size_t l) { return c[l]->contact.overlap; });
+    const T radius = gather_lanes([&](std::size_t l) { return p.radius[particle(l)]; });
     // r ω at the time of the positions and over the last step.
     if constexpr (D == 2) {
-      const T spin =
-          gather([&](std::size_t l) { return p.radius[particle(l)] * spin_now_[particle(l)]; });
-      const T step_spin = gather(
+      const T spin = gather_lanes(
+          [&](std::size_t l) { return p.radius[particle(l)] * spin_now_[particle(l)]; });
+      const T step_spin = gather_lanes(
           [&](std::size_t l) { return p.radius[particle(l)] * p.angular_velocity[particle(l)]; });
       in.spin_velocity = cross(in.normal, spin);
       in.step_spin_velocity = cross(in.normal, step_spin);
     } else {
       Vec<3, T> spin, step_spin;
       for (int d = 0; d < 3; ++d) {
-        spin[d] = gather(
+        spin[d] = gather_lanes(
             [&](std::size_t l) { return p.radius[particle(l)] * spin_now_[particle(l)][d]; });
-        step_spin[d] = gather([&](std::size_t l) {
+        step_spin[d] = gather_lanes([&](std::size_t l) {
           return p.radius[particle(l)] * p.angular_velocity[particle(l)][d];
         });
       }
@@ -887,20 +874,20 @@ void World<D>::evaluate_wall_laws_in_lanes(WallWork* work, std::size_t count) {
       in.step_spin_velocity = cross(in.normal, step_spin);
     }
     ContactDampingOf<T> damping;
-    damping.normal = gather([&](std::size_t l) { return wall_damping_[particle(l)].normal; });
+    damping.normal = gather_lanes([&](std::size_t l) { return wall_damping_[particle(l)].normal; });
     damping.tangential =
-        gather([&](std::size_t l) { return wall_damping_[particle(l)].tangential; });
+        gather_lanes([&](std::size_t l) { return wall_damping_[particle(l)].tangential; });
     ContactHistory<D, T> held;
     const auto history = [&](std::size_t l) -> ContactHistory<D>& {
       return wall_slot_history_[c[l]->slot];
     };
     held.normal_spring_origin =
-        gather([&](std::size_t l) { return history(l).normal_spring_origin; });
+        gather_lanes([&](std::size_t l) { return history(l).normal_spring_origin; });
     for (int d = 0; d < D; ++d) {
       held.tangential_spring[d] =
-          gather([&](std::size_t l) { return history(l).tangential_spring[d]; });
+          gather_lanes([&](std::size_t l) { return history(l).tangential_spring[d]; });
     }
-    held.dissipated = gather([&](std::size_t l) { return history(l).dissipated; });
+    held.dissipated = gather_lanes([&](std::size_t l) { return history(l).dissipated; });
     const ContactOutput<D, T> out = ball_wall_law_.evaluate(in, damping, held, dt);
     const auto moment = -radius * cross(in.normal, out.tangential_force);
     for (std::size_t l = 0; l < filled; ++l) {

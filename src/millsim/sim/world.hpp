@@ -94,7 +94,7 @@ class World {
     nearby_lifter_lists_ = on;
     nearby_lifters_.clear();
   }
-  /// Whether the pair stage's lanes (core/lanes.hpp) use AVX2 instructions, as they do by
+  /// Whether the pair and wall stages' lanes (core/lanes.hpp) use AVX2 instructions, as they do by
   /// default where the processor has them; off, the instructions of any x86-64 processor. The
   /// results are the same bit for bit either way; tests switch it off to show that.
   void set_avx2_lanes(bool on);
