@@ -166,6 +166,17 @@ TEST(ContactLanes, HelpersWorkLaneByLane) {
     EXPECT_EQ(chosen[l], x[l] > 0.0 ? x[l] : 7.0);
     EXPECT_EQ(gathered[l], 10.0 * static_cast<double>(l));
   }
+  // Spins: a number per lane in 2D, a vector per lane in 3D.
+  const Lanes spin_2d = gather_spin_lanes<2>([](std::size_t l) { return static_cast<double>(l); });
+  const Vec<3, Lanes> spin_3d = gather_spin_lanes<3>([](std::size_t l) {
+    const auto a = static_cast<double>(l);
+    return Vec3{{a, 2.0 * a, 3.0 * a}};
+  });
+  for (std::size_t l = 0; l < lanes; ++l) {
+    const auto a = static_cast<double>(l);
+    EXPECT_EQ(spin_2d[l], a);
+    for (int d = 0; d < 3; ++d) EXPECT_EQ(spin_3d[d][l], (d + 1) * a);
+  }
 }
 
 }  // namespace

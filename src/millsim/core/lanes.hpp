@@ -63,6 +63,18 @@ template <class F>
   (std::make_index_sequence<static_cast<std::size_t>(lane_count)>{});
 }
 
+/// Lanes of one spin per lane (Spin<D>: a number in 2D, a vector in 3D): f(l) in lane l.
+template <int D, class F>
+[[gnu::always_inline]] inline auto gather_spin_lanes(F&& f) {
+  if constexpr (D == 2) {
+    return gather_lanes(f);
+  } else {
+    Vec<3, Lanes> r;
+    for (int d = 0; d < 3; ++d) r[d] = gather_lanes([&](std::size_t l) { return f(l)[d]; });
+    return r;
+  }
+}
+
 /// The same value in every lane.
 template <class T>
 [[gnu::always_inline]] inline T splat(double x) {

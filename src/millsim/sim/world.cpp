@@ -646,27 +646,14 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
     in.overlap = reach - distance;
     in.velocity = velocity;
     in.step_velocity = step_velocity;
-    // r_i ω_i + r_j ω_j, at the time of the positions and over the last step.
-    if constexpr (D == 2) {
-      const T spin =
-          gather_lanes([&](std::size_t l) { return r[i[l]] * w[i[l]] + r[j[l]] * w[j[l]]; });
-      const T step_spin = gather_lanes([&](std::size_t l) {
-        return r[i[l]] * p.angular_velocity[i[l]] + r[j[l]] * p.angular_velocity[j[l]];
-      });
-      in.spin_velocity = cross(in.normal, spin);
-      in.step_spin_velocity = cross(in.normal, step_spin);
-    } else {
-      Vec<3, T> spin, step_spin;
-      for (int d = 0; d < 3; ++d) {
-        spin[d] = gather_lanes(
-            [&](std::size_t l) { return r[i[l]] * w[i[l]][d] + r[j[l]] * w[j[l]][d]; });
-        step_spin[d] = gather_lanes([&](std::size_t l) {
-          return r[i[l]] * p.angular_velocity[i[l]][d] + r[j[l]] * p.angular_velocity[j[l]][d];
-        });
-      }
-      in.spin_velocity = cross(in.normal, spin);
-      in.step_spin_velocity = cross(in.normal, step_spin);
-    }
+    // n × (r_i ω_i + r_j ω_j), at the time of the positions and over the last step.
+    in.spin_velocity = cross(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
+                               return r[i[l]] * w[i[l]] + r[j[l]] * w[j[l]];
+                             }));
+    in.step_spin_velocity =
+        cross(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
+                return r[i[l]] * p.angular_velocity[i[l]] + r[j[l]] * p.angular_velocity[j[l]];
+              }));
     const T mass_i = gather_lanes([&](std::size_t l) { return p.mass[i[l]]; });
     const T mass_j = gather_lanes([&](std::size_t l) { return p.mass[j[l]]; });
     ContactHistory<D, T> held;
@@ -853,26 +840,13 @@ void World<D>::evaluate_wall_laws_in_lanes(WallWork* work, std::size_t count) {
     }
     in.overlap = gather_lanes([&](std::size_t l) { return c[l]->contact.overlap; });
     const T radius = gather_lanes([&](std::size_t l) { return p.radius[particle(l)]; });
-    // r ω at the time of the positions and over the last step.
-    if constexpr (D == 2) {
-      const T spin = gather_lanes(
-          [&](std::size_t l) { return p.radius[particle(l)] * spin_now_[particle(l)]; });
-      const T step_spin = gather_lanes(
-          [&](std::size_t l) { return p.radius[particle(l)] * p.angular_velocity[particle(l)]; });
-      in.spin_velocity = cross(in.normal, spin);
-      in.step_spin_velocity = cross(in.normal, step_spin);
-    } else {
-      Vec<3, T> spin, step_spin;
-      for (int d = 0; d < 3; ++d) {
-        spin[d] = gather_lanes(
-            [&](std::size_t l) { return p.radius[particle(l)] * spin_now_[particle(l)][d]; });
-        step_spin[d] = gather_lanes([&](std::size_t l) {
-          return p.radius[particle(l)] * p.angular_velocity[particle(l)][d];
-        });
-      }
-      in.spin_velocity = cross(in.normal, spin);
-      in.step_spin_velocity = cross(in.normal, step_spin);
-    }
+    // n × r ω, at the time of the positions and over the last step.
+    in.spin_velocity = cross(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
+                               return p.radius[particle(l)] * spin_now_[particle(l)];
+                             }));
+    in.step_spin_velocity = cross(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
+                                    return p.radius[particle(l)] * p.angular_velocity[particle(l)];
+                                  }));
     ContactDampingOf<T> damping;
     damping.normal = gather_lanes([&](std::size_t l) { return wall_damping_[particle(l)].normal; });
     damping.tangential =
