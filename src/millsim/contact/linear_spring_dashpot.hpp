@@ -67,8 +67,8 @@ class LinearSpringDashpot {
   }
 
   /// The same with the dashpot coefficients given (from damping(in.effective_mass)).
-  /// Always inlined: the pair and wall loops call it once per contact and step, and the
-  /// inputs and outputs then stay in registers.
+  /// Always inlined: the pair and wall loops call it once per contact (or four) and step, the
+  /// inputs and outputs then stay in registers, and Lanes never cross a call (core/vec.hpp).
   template <int D, class T>
   [[gnu::always_inline]] ContactOutput<D, T> evaluate(const ContactInput<D, T>& in,
                                                       const ContactDampingOf<T>& damping,
@@ -117,7 +117,8 @@ class LinearSpringDashpot {
     const T friction_limit = splat<T>(friction_) * lane_abs(normal_force);
     const T tangential_damping = damping.tangential;
     const V trial = spring - tangential_damping * sliding_velocity;
-    // Compared squared, so that a sticking contact (most of them) needs no square root.
+    // Compared squared. (The root below is needed only where the contact slips, but without
+    // branches every contact works it out; in lanes it costs one instruction for four.)
     const T trial_length_squared = norm_squared(trial);
     const Mask<T> slips = trial_length_squared > friction_limit * friction_limit;
     // Slipping. The friction work is the work the force does against the slip at the time
