@@ -31,6 +31,13 @@ constexpr std::size_t parallel_threshold = 2048;
 /// (the 2D SAG scene has about a thousand candidates; on one thread they held the other one
 /// waiting for 3 % of the step).
 constexpr std::size_t parallel_wall_threshold = 2 * wall_block;
+/// When the particle arrays that the pair kernel reads and writes hold more than this many
+/// bytes, several times a core's second-level cache, the kernel prefetches the particles and
+/// history of the pairs two lanes ahead: the second particle of a pair is met out of order and
+/// comes from memory otherwise. Below it the prefetches cost more than they save
+/// (bench/results.md: +10 % on the 1e5-ball slab of the scaling series, −3 % on the 3D 20 k
+/// scene).
+constexpr std::size_t prefetch_threshold_bytes = std::size_t{8} << 20;
 
 /// Whether this processor has AVX2 (asked once).
 bool processor_has_avx2() {
@@ -136,6 +143,9 @@ void World<D>::refresh_neighbours() {
   wall_damping_.resize(count);
   for (std::size_t i = 0; i < count; ++i) wall_damping_[i] = ball_wall_law_.damping(m[i]);
   pair_ended_.resize(pairs);
+  // The arrays of prefetch_pairs.
+  constexpr std::size_t kernel_bytes = 3 * sizeof(Vec<D>) + 3 * sizeof(Spin<D>) + sizeof(double);
+  prefetch_pairs_ = count * kernel_bytes > prefetch_threshold_bytes;
   pair_block_ended_.resize(block_count(pairs, pair_block));
   pair_block_dissipated_.resize(block_count(pairs, pair_block));
 
@@ -588,7 +598,11 @@ void World<D>::evaluate_listed_pairs(std::size_t block, const std::uint32_t* lis
     return;
   }
 #endif
-  evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended);
+  if (prefetch_pairs_) {
+    evaluate_listed_pairs_in_lanes<true>(block, listed, count, dissipated, ended);
+  } else {
+    evaluate_listed_pairs_in_lanes<false>(block, listed, count, dissipated, ended);
+  }
 }
 
 #if defined(__x86_64__)
@@ -596,11 +610,34 @@ template <int D>
 void World<D>::evaluate_listed_pairs_avx2(std::size_t block, const std::uint32_t* listed,
                                           std::size_t count, double& dissipated,
                                           std::uint32_t& ended) {
-  evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended);
+  if (prefetch_pairs_) {
+    evaluate_listed_pairs_in_lanes<true>(block, listed, count, dissipated, ended);
+  } else {
+    evaluate_listed_pairs_in_lanes<false>(block, listed, count, dissipated, ended);
+  }
 }
 #endif
 
 template <int D>
+void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, std::size_t end) {
+  const auto& p = particles_;
+  for (std::size_t k = begin; k < end; ++k) {
+    const std::uint32_t q = listed[k];
+    __builtin_prefetch(&neighbours_.history()[q]);
+    for (const std::uint32_t i : {neighbours_.first()[q], neighbours_.second()[q]}) {
+      __builtin_prefetch(&velocity_now_[i]);
+      __builtin_prefetch(&spin_now_[i]);
+      __builtin_prefetch(&p.velocity[i]);
+      __builtin_prefetch(&p.angular_velocity[i]);
+      __builtin_prefetch(&p.mass[i]);
+      __builtin_prefetch(&p.force[i], 1);
+      __builtin_prefetch(&p.torque[i], 1);
+    }
+  }
+}
+
+template <int D>
+template <bool Prefetch>
 void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint32_t* listed,
                                               std::size_t count, double& dissipated,
                                               std::uint32_t& ended) {
@@ -618,6 +655,8 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
   const std::size_t begin = block * pair_block;
 
   for (std::size_t k = 0; k < count; k += lanes) {
+    if constexpr (Prefetch)
+      prefetch_pairs(listed, std::min(count, k + 2 * lanes), std::min(count, k + 3 * lanes));
     // The pairs of the lanes; where fewer remain, the last one fills the rest.
     std::array<std::uint32_t, lanes> q{}, i{}, j{};
     const std::size_t filled = std::min(lanes, count - k);

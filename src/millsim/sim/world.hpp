@@ -152,11 +152,16 @@ class World {
                                                                   double& dissipated,
                                                                   std::uint32_t& ended);
 #endif
+  template <bool Prefetch>
   [[gnu::always_inline]] inline void evaluate_listed_pairs_in_lanes(std::size_t block,
                                                                     const std::uint32_t* listed,
                                                                     std::size_t count,
                                                                     double& dissipated,
                                                                     std::uint32_t& ended);
+  /// Asks the processor to fetch what the pair kernel will read and write of listed pairs
+  /// [begin, end): their history, and both particles' velocities, spins, masses and sums.
+  [[gnu::always_inline]] inline void prefetch_pairs(const std::uint32_t* listed, std::size_t begin,
+                                                    std::size_t end);
   void split_pairs_among(int threads);
   /// Whether the pair stage runs on several threads; if so, makes sure its split of particles
   /// and pairs among them (split_pairs_among) is that of the current list and thread count.
@@ -269,6 +274,9 @@ class World {
   // nearby_lifter_angle_ (refresh_nearby_lifters).
   bool nearby_lifter_lists_ = true;
   bool avx2_lanes_ = false;
+  /// Whether the pair kernel prefetches (prefetch_pairs): set at each rebuild from the number
+  /// of particles.
+  bool prefetch_pairs_ = false;
   std::vector<NearbyLifters> nearby_lifters_;
   double nearby_lifter_angle_ = 0.0;
   double lifter_travel_ = 0.0;
