@@ -89,11 +89,15 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
     cell_start_.assign(total + 1, 0);
     std::vector<std::array<long, D>>& home = particle_home_;
     home.resize(count);
+    // The cell along axis a of coordinate x (clamped to the grid).
+    const auto cell_of = [&](double x, int a) {
+      const auto c = static_cast<long>(std::max(0.0, x - low[a]) / side[a]);
+      return std::min(c, cells[a] - 1);
+    };
     for (std::size_t i = 0; i < count; ++i) {
       std::size_t index = 0;
       for (int a = D - 1; a >= 0; --a) {
-        const auto c = static_cast<long>(std::max(0.0, position[i][a] - low[a]) / side[a]);
-        home[i][a] = std::min(c, cells[a] - 1);
+        home[i][a] = cell_of(position[i][a], a);
         index = index * static_cast<std::size_t>(cells[a]) + static_cast<std::size_t>(home[i][a]);
       }
       particle_cell_[i] = static_cast<std::uint32_t>(index);
@@ -139,16 +143,22 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       std::array<long, D> from{};
       std::array<long, D> to{};
       for (int a = 0; a < D; ++a) {
-        const long range = static_cast<long>(std::ceil(cutoff / side[a]));
-        from[a] = own_home[a] - range;
-        to[a] = own_home[a] + range;
-        if (periodic && a == D - 1 && to[a] - from[a] + 1 >= cells[a]) {
-          from[a] = 0;  // the range wraps onto itself: visit every cell along the axis once
-          to[a] = cells[a] - 1;
-        } else if (!(periodic && a == D - 1)) {
-          from[a] = std::max(0L, from[a]);
-          to[a] = std::min(cells[a] - 1, to[a]);
+        if (periodic && a == D - 1) {
+          const long range = static_cast<long>(std::ceil(cutoff / side[a]));
+          from[a] = own_home[a] - range;
+          to[a] = own_home[a] + range;
+          if (to[a] - from[a] + 1 >= cells[a]) {
+            from[a] = 0;  // the range wraps onto itself: visit every cell along the axis once
+            to[a] = cells[a] - 1;
+          }
+          continue;
         }
+        // The cells that [x − cutoff, x + cutoff] meets, found as the particles' own cells were
+        // (a partner inside that span lies in one of them), the span widened by a hair against
+        // rounding.
+        const double reach_a = cutoff * (1.0 + 1e-9);
+        from[a] = cell_of(own_position[a] - reach_a, a);
+        to[a] = cell_of(own_position[a] + reach_a, a);
       }
       // Cells along axis 0 are contiguous in the cell order, so each row of the range is one
       // run of cell_members_ (axis 0 is never periodic).
