@@ -27,6 +27,12 @@ constexpr std::size_t pair_block = 1024;
 constexpr std::size_t wall_block = 256;
 /// Below this many items a stage runs on one thread (a parallel region costs microseconds).
 constexpr std::size_t parallel_threshold = 2048;
+/// The pair stage, and with it the particle stages, split among threads from this many listed
+/// pairs, where two threads and one break even: below it the threads' barriers cost more than
+/// the split saves (the 3D scaling slab on two threads against one: 996 balls and 2 500 pairs
+/// 1.5 times slower, 2 000 balls and 5 000 pairs as fast, 4 000 balls and 10 000 pairs 1.4
+/// times faster; bench/results.md).
+constexpr std::size_t parallel_pair_threshold = 5120;
 /// The same for the wall stage, whose candidates cost tens of pairs each: from two blocks on
 /// (the 2D SAG scene has about a thousand candidates; on one thread they held the other one
 /// waiting for 3 % of the step).
@@ -284,7 +290,7 @@ template <int D>
 bool World<D>::pairs_split_among_threads() {
   const int threads = omp_get_max_threads();
   const std::size_t pairs = neighbours_.pair_count();
-  if (pairs < parallel_threshold || threads == 1) return false;
+  if (pairs < parallel_pair_threshold || threads == 1) return false;
   if (threads != split_threads_ || neighbours_.rebuild_count() != split_rebuild_ ||
       split_pair_.back() != pairs) {
     split_pairs_among(threads);
