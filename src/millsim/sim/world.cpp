@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <bit>
 #include <type_traits>
 
 namespace millsim {
@@ -774,7 +775,7 @@ void World<D>::evaluate_wall_contacts() {
       const std::uint32_t i = wall_candidates_[k];
       std::int32_t* slot_id = &wall_slot_id_[k * max_wall_contacts];
       const ContactHistory<D>* slot_history = &wall_slot_history_[k * max_wall_contacts];
-      std::array<bool, max_wall_contacts> seen{};
+      unsigned seen = 0;  // bit s: slot s touched now
       const NearbyLifters* nearby = nearby_lifters_.empty() ? nullptr : &nearby_lifters_[k];
       walls_.for_each_contact(
           particles_.position[i], particles_.radius[i],
@@ -787,7 +788,7 @@ void World<D>::evaluate_wall_contacts() {
               if (slot == max_wall_contacts) return;  // cannot happen: see max_wall_contacts
               slot_id[slot] = contact.wall_id;
             }
-            seen[static_cast<std::size_t>(slot)] = true;
+            seen |= 1U << static_cast<unsigned>(slot);
             WallWork found;
             found.particle = i;
             found.slot = static_cast<std::uint32_t>(k * max_wall_contacts) +
@@ -799,8 +800,12 @@ void World<D>::evaluate_wall_contacts() {
       first_work[k - begin + 1] = static_cast<std::uint32_t>(work_list.size());
       // Slots of walls the candidate no longer touches: their collisions have ended. (The law
       // below works on the touched slots alone.)
+      unsigned held = 0;  // bit s: slot s holds a wall's history
       for (int slot = 0; slot < max_wall_contacts; ++slot) {
-        if (slot_id[slot] < 0 || seen[static_cast<std::size_t>(slot)]) continue;
+        held |= slot_id[slot] >= 0 ? 1U << static_cast<unsigned>(slot) : 0U;
+      }
+      for (unsigned ended_slots = held & ~seen; ended_slots != 0; ended_slots &= ended_slots - 1) {
+        const int slot = std::countr_zero(ended_slots);
         block_ended[ended++] = {wall_contact_type(walls_.kind_of(slot_id[slot])),
                                 slot_history[slot].dissipated};
         wall_slot_history_[k * max_wall_contacts + static_cast<std::size_t>(slot)] =
@@ -810,6 +815,9 @@ void World<D>::evaluate_wall_contacts() {
     }
     evaluate_wall_laws(work_list.data(), work_list.size());
     for (std::size_t k = begin; k < end; ++k) {
+      // A candidate touching no wall adds nothing: its sums, begun at +0 and so never −0 (in
+      // round-to-nearest x + y is −0 only if both are), would stay the same bits.
+      if (first_work[k - begin] == first_work[k - begin + 1]) continue;
       const std::uint32_t i = wall_candidates_[k];
       Vec<D> force{};
       Spin<D> moment{};
