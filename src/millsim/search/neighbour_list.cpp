@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 
+#include "millsim/core/vector_growth.hpp"
+
 namespace millsim {
 namespace {
 
@@ -217,6 +219,8 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       found_count += found_[chunk].size();
     }
     for (std::size_t i = 0; i < count; ++i) pair_cursor_[i + 1] += pair_cursor_[i];
+    reserve_with_slack(next_first_, found_count);
+    reserve_with_slack(next_second_, found_count);
     next_first_.resize(found_count);
     next_second_.resize(found_count);
     for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
@@ -237,6 +241,8 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
   // of the two old indices. A pair whose particles were renumbered in the other order has its
   // bodies A and B swapped: its tangential spring, the force on B, changes sign (the other
   // quantities of the history are the same for both bodies).
+  reserve_with_slack(next_history_, next_first_.size());
+  reserve_with_slack(next_touching_, next_first_.size());
   next_history_.assign(next_first_.size(), ContactHistory<D>{});
   next_touching_.assign(next_first_.size(), TouchState::apart);
   const std::size_t old_count = first_begin_.empty() ? 0 : first_begin_.size() - 1;

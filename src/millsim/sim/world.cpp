@@ -6,6 +6,8 @@
 #include <bit>
 #include <type_traits>
 
+#include "millsim/core/vector_growth.hpp"
+
 namespace millsim {
 namespace {
 
@@ -165,6 +167,9 @@ void World<D>::refresh_neighbours() {
   wall_candidates_.clear();
   next_wall_slot_id_.clear();
   next_wall_slot_history_.clear();
+  // About as many candidates as last time.
+  reserve_with_slack(next_wall_slot_id_, wall_slot_id_.size());
+  reserve_with_slack(next_wall_slot_history_, wall_slot_history_.size());
   for (std::size_t i = 0; i < count; ++i) {
     const std::uint32_t held = wall_slots_of_[i];
     const std::size_t from = static_cast<std::size_t>(held) * slots;
