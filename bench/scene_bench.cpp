@@ -187,7 +187,6 @@ struct ArrayEstimate {
 
 template <int D>
 ArrayEstimate estimate_array_bytes(const millsim::World<D>& world) {
-  using millsim::ContactDamping;
   using millsim::ContactHistory;
   using millsim::Spin;
   using millsim::Vec;
@@ -201,10 +200,9 @@ ArrayEstimate estimate_array_bytes(const millsim::World<D>& world) {
   const double pairs = static_cast<double>(list.pair_count());
   constexpr double index = sizeof(std::uint32_t);
   constexpr double store = 3 * sizeof(Vec<D>) + 2 * sizeof(Spin<D>) + 4 * sizeof(double);
-  // u̇(n), ω(n), wall dashpots, the index of its wall-contact slots; per wall candidate, the
-  // slots (id and history) and their rebuild copies.
-  constexpr double world_per_particle =
-      sizeof(Vec<D>) + sizeof(Spin<D>) + sizeof(ContactDamping) + index;
+  // u̇(n), ω(n), the index of its wall-contact slots; per wall candidate, the slots (id and
+  // history) and their rebuild copies.
+  constexpr double world_per_particle = sizeof(Vec<D>) + sizeof(Spin<D>) + index;
   constexpr double world_per_candidate =
       2 * millsim::World<D>::max_wall_contacts * (sizeof(std::int32_t) + sizeof(ContactHistory<D>));
   const double candidates_per_particle =

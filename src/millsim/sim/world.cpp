@@ -148,9 +148,6 @@ void World<D>::refresh_neighbours() {
   neighbours_.rebuild(particles_.position, particles_.radius, into_cell_order);
   if (into_cell_order) reorder_particles(neighbours_.previous_index());
   const std::size_t pairs = neighbours_.pair_count();
-  const auto& m = particles_.mass;
-  wall_damping_.resize(count);
-  for (std::size_t i = 0; i < count; ++i) wall_damping_[i] = ball_wall_law_.damping(m[i]);
   pair_ended_.resize(pairs);
   // The arrays of prefetch_pairs.
   constexpr std::size_t kernel_bytes = 3 * sizeof(Vec<D>) + 3 * sizeof(Spin<D>) + sizeof(double);
@@ -905,10 +902,10 @@ void World<D>::evaluate_wall_laws_in_lanes(WallWork* work, std::size_t count) {
     in.step_spin_velocity = cross(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
                                     return p.radius[particle(l)] * p.angular_velocity[particle(l)];
                                   }));
-    ContactDampingOf<T> damping;
-    damping.normal = gather_lanes([&](std::size_t l) { return wall_damping_[particle(l)].normal; });
-    damping.tangential =
-        gather_lanes([&](std::size_t l) { return wall_damping_[particle(l)].tangential; });
+    // The dashpots' coefficients from the particle's mass (m* = m against a wall), worked out
+    // here as the pair kernel does, not kept per particle.
+    const ContactDampingOf<T> damping =
+        ball_wall_law_.damping(gather_lanes([&](std::size_t l) { return p.mass[particle(l)]; }));
     ContactHistory<D, T> held;
     const auto history = [&](std::size_t l) -> ContactHistory<D>& {
       return wall_slot_history_[c[l]->slot];

@@ -261,7 +261,6 @@ class World {
 
   // Particles that may touch a wall before the next neighbour-list rebuild.
   std::vector<std::uint32_t> wall_candidates_;
-  std::vector<ContactDamping> wall_damping_;  // per particle, set at each rebuild
   // Per wall candidate (in the order of wall_candidates_), max_wall_contacts slots of
   // wall-contact history keyed by wall id; per particle, which candidate's slots are its own
   // (no_wall_slots: none, it is not a candidate); and the arrays the next rebuild fills.
