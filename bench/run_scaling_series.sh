@@ -19,7 +19,7 @@
 # per CPU second, bytes per particle: resident growth and the array estimate, neighbour-list
 # rebuilds), then the ratio of the slowest to the fastest rate of the ordered series. CPU time
 # is the figure to read on a shared machine. About 10 minutes of CPU time on one thread;
-# 1.03 GB of resident growth at the largest point (1003 B per ball at f300219, 1030 B at b13b5d1, 1199 B at
+# 1.0 GB of resident growth at the largest point (1003 B per ball at f300219, 1030 B at b13b5d1, 1199 B at
 # a6911f1, 1.84 GB before 5635d51).
 #
 #   bench/run_scaling_series.sh [THREADS]          (default: 1 thread)
