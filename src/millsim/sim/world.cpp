@@ -607,11 +607,7 @@ void World<D>::evaluate_listed_pairs(std::size_t block, const std::uint32_t* lis
     return;
   }
 #endif
-  if (prefetch_pairs_) {
-    evaluate_listed_pairs_in_lanes<true>(block, listed, count, dissipated, ended);
-  } else {
-    evaluate_listed_pairs_in_lanes<false>(block, listed, count, dissipated, ended);
-  }
+  evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended);
 }
 
 #if defined(__x86_64__)
@@ -619,11 +615,7 @@ template <int D>
 void World<D>::evaluate_listed_pairs_avx2(std::size_t block, const std::uint32_t* listed,
                                           std::size_t count, double& dissipated,
                                           std::uint32_t& ended) {
-  if (prefetch_pairs_) {
-    evaluate_listed_pairs_in_lanes<true>(block, listed, count, dissipated, ended);
-  } else {
-    evaluate_listed_pairs_in_lanes<false>(block, listed, count, dissipated, ended);
-  }
+  evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended);
 }
 #endif
 
@@ -646,7 +638,6 @@ void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, st
 }
 
 template <int D>
-template <bool Prefetch>
 void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint32_t* listed,
                                               std::size_t count, double& dissipated,
                                               std::uint32_t& ended) {
@@ -664,7 +655,7 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
   const std::size_t begin = block * pair_block;
 
   for (std::size_t k = 0; k < count; k += lanes) {
-    if constexpr (Prefetch)
+    if (prefetch_pairs_)
       prefetch_pairs(listed, std::min(count, k + 2 * lanes), std::min(count, k + 3 * lanes));
     // The pairs of the lanes; where fewer remain, the last one fills the rest.
     std::array<std::uint32_t, lanes> q{}, i{}, j{};

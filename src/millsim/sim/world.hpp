@@ -152,7 +152,6 @@ class World {
                                                                   double& dissipated,
                                                                   std::uint32_t& ended);
 #endif
-  template <bool Prefetch>
   [[gnu::always_inline]] inline void evaluate_listed_pairs_in_lanes(std::size_t block,
                                                                     const std::uint32_t* listed,
                                                                     std::size_t count,
