@@ -767,7 +767,7 @@ void World<D>::evaluate_wall_contacts() {
     for (std::size_t k = begin; k < end; ++k) {
       const std::uint32_t i = wall_candidates_[k];
       std::int32_t* slot_id = &wall_slot_id_[k * max_wall_contacts];
-      const ContactHistory<D>* slot_history = &wall_slot_history_[k * max_wall_contacts];
+      ContactHistory<D>* slot_history = &wall_slot_history_[k * max_wall_contacts];
       unsigned seen = 0;  // bit s: slot s touched now
       const NearbyLifters* nearby = nearby_lifters_.empty() ? nullptr : &nearby_lifters_[k];
       walls_.for_each_contact(
@@ -801,8 +801,7 @@ void World<D>::evaluate_wall_contacts() {
         const int slot = std::countr_zero(ended_slots);
         block_ended[ended++] = {wall_contact_type(walls_.kind_of(slot_id[slot])),
                                 slot_history[slot].dissipated};
-        wall_slot_history_[k * max_wall_contacts + static_cast<std::size_t>(slot)] =
-            ContactHistory<D>{};
+        slot_history[slot] = ContactHistory<D>{};
         slot_id[slot] = -1;
       }
     }
