@@ -19,21 +19,25 @@ constexpr std::size_t parallel_search_threshold = 2048;
 template <int D>
 bool NeighbourList<D>::needs_refresh(const std::vector<Vec<D>>& position) const {
   if (position.size() != reference_position_.size()) return true;
+  return moved_too_far(position, 0, position.size());
+}
+
+template <int D>
+bool NeighbourList<D>::moved_too_far(const std::vector<Vec<D>>& position, std::size_t begin,
+                                     std::size_t end) const {
   const double limit = 0.25 * skin_ * skin_;  // (skin / 2)²
-  const auto moved_too_far = [&](std::size_t i) {
-    return norm_squared(separation(reference_position_[i], position[i])) > limit;
-  };
-  const std::size_t count = position.size();
-  if (count < parallel_search_threshold) {
-    for (std::size_t i = 0; i < count; ++i) {
-      if (moved_too_far(i)) return true;
-    }
-    return false;
-  }
-  // Every step asks: on several threads, each looks at its share of the particles through.
+  // Every step asks, and the answer is almost always no: every particle is looked at, without
+  // a branch, so that the compiler can work on several at once.
   bool moved = false;
-#pragma omp parallel for schedule(static) reduction(|| : moved)
-  for (std::size_t i = 0; i < count; ++i) moved = moved || moved_too_far(i);
+  if (period_ > 0.0) {
+    for (std::size_t i = begin; i < end; ++i) {
+      moved |= norm_squared(separation(reference_position_[i], position[i])) > limit;
+    }
+    return moved;
+  }
+  for (std::size_t i = begin; i < end; ++i) {
+    moved |= norm_squared(position[i] - reference_position_[i]) > limit;
+  }
   return moved;
 }
 

@@ -43,6 +43,11 @@ class NeighbourList {
   /// True when a particle has moved more than half the skin since the last rebuild (or the
   /// particle count changed): only then can a pair not in the list have come into contact.
   bool needs_refresh(const std::vector<Vec<D>>& position) const;
+  /// Whether a particle among [begin, end) has moved more than half the skin since the last
+  /// rebuild, for positions of the particles the list was built for (built_count()).
+  bool moved_too_far(const std::vector<Vec<D>>& position, std::size_t begin, std::size_t end) const;
+  /// The number of particles the list was built for.
+  std::size_t built_count() const { return reference_position_.size(); }
 
   /// Rebuilds the pair list, sorted by (first, second), carrying each kept pair's history.
   /// With into_cell_order, the particles are also renumbered in the order of the grid's cells,

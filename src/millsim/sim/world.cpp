@@ -117,8 +117,8 @@ double World<D>::axial_period() const {
 
 template <int D>
 void World<D>::step() {
-  refresh_neighbours();
-  estimate_current_velocities();
+  const bool moved = estimate_current_velocities();
+  refresh_neighbours(moved);
   evaluate_pair_contacts();
   evaluate_wall_contacts();
   accumulate_forces_and_integrate();
@@ -128,7 +128,7 @@ void World<D>::step() {
 }
 
 template <int D>
-void World<D>::refresh_neighbours() {
+void World<D>::refresh_neighbours(bool moved) {
   const std::size_t count = particles_.size();
   // Particles added since the last step are at the end, each with its index as id and no
   // wall-contact slots.
@@ -137,7 +137,7 @@ void World<D>::refresh_neighbours() {
     particle_index_.push_back(static_cast<std::uint32_t>(i));
     wall_slots_of_.push_back(no_wall_slots);
   }
-  if (!neighbours_.needs_refresh(particles_.position)) {
+  if (!moved) {
     if (lifters_moved_too_far()) refresh_nearby_lifters();
     return;
   }
@@ -262,13 +262,16 @@ double World<D>::choose_skin() const {
 
 template <int D>
 void World<D>::reorder_particles(const std::vector<std::uint32_t>& previous) {
-  // Everything per particle that lasts beyond this step is reordered; what the step rewrites
-  // before reading it again (velocity_now_, spin_now_, wall forces and dashpots) is not.
+  // Everything per particle that the step reads after the rebuild is reordered: what lasts
+  // from step to step and this step's velocity estimates.
   particles_.for_each_array([&](auto& values) {
     using Element = typename std::decay_t<decltype(values)>::value_type;
     reorder(values, previous, 1, std::get<std::vector<Element>>(reorder_scratch_));
   });
   reorder(particle_id_, previous, 1, std::get<std::vector<std::uint32_t>>(reorder_scratch_));
+  // This step's velocity estimates, made before the rebuild.
+  reorder(velocity_now_, previous, 1, std::get<std::vector<Vec<D>>>(reorder_scratch_));
+  reorder(spin_now_, previous, 1, std::get<std::vector<Spin<D>>>(reorder_scratch_));
   reorder(wall_slots_of_, previous, 1, std::get<std::vector<std::uint32_t>>(reorder_scratch_));
   for (std::size_t k = 0; k < particle_id_.size(); ++k) {
     particle_index_[particle_id_[k]] = static_cast<std::uint32_t>(k);
@@ -304,33 +307,54 @@ bool World<D>::pairs_split_among_threads() {
 template <int D>
 template <class Body>
 void World<D>::for_each_particle(Body&& body) {
-  const std::size_t count = particles_.size();
-  if (pairs_split_among_threads()) {
-    const auto ranges = static_cast<std::size_t>(split_threads_);
-#pragma omp parallel num_threads(split_threads_)
-    {
-      const auto team = static_cast<std::size_t>(omp_get_num_threads());
-      for (auto t = static_cast<std::size_t>(omp_get_thread_num()); t < ranges; t += team) {
-        for (std::size_t i = split_particle_[t]; i < split_particle_[t + 1]; ++i) body(i);
-      }
-    }
-    return;
-  }
-#pragma omp parallel for schedule(static) if (count >= parallel_threshold)
-  for (std::size_t i = 0; i < count; ++i) body(i);
+  for_each_particle_run([&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) body(i);
+    return false;
+  });
 }
 
 template <int D>
-void World<D>::estimate_current_velocities() {
+template <class Body>
+bool World<D>::for_each_particle_run(Body&& body) {
+  const std::size_t count = particles_.size();
+  bool any = false;
+  if (count == neighbours_.built_count() && pairs_split_among_threads()) {
+    const auto ranges = static_cast<std::size_t>(split_threads_);
+#pragma omp parallel num_threads(split_threads_) reduction(|| : any)
+    {
+      const auto team = static_cast<std::size_t>(omp_get_num_threads());
+      for (auto t = static_cast<std::size_t>(omp_get_thread_num()); t < ranges; t += team) {
+        any = body(std::size_t{split_particle_[t]}, std::size_t{split_particle_[t + 1]}) || any;
+      }
+    }
+    return any;
+  }
+#pragma omp parallel if (count >= parallel_threshold) reduction(|| : any)
+  {
+    const auto team = static_cast<std::size_t>(omp_get_num_threads());
+    const auto t = static_cast<std::size_t>(omp_get_thread_num());
+    any = body(count * t / team, count * (t + 1) / team);
+  }
+  return any;
+}
+
+template <int D>
+bool World<D>::estimate_current_velocities() {
   const std::size_t count = particles_.size();
   velocity_now_.resize(count);
   spin_now_.resize(count);
   const double half_step = 0.5 * settings_.time_step;
   const auto& p = particles_;
-  for_each_particle([&](std::size_t i) {
-    velocity_now_[i] = p.velocity[i] + (half_step * p.inverse_mass[i]) * p.force[i];
-    spin_now_[i] = p.angular_velocity[i] + (half_step * p.inverse_inertia[i]) * p.torque[i];
+  // Particles added since the last list: it must be made again.
+  const bool added = count != neighbours_.built_count();
+  const bool moved = for_each_particle_run([&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      velocity_now_[i] = p.velocity[i] + (half_step * p.inverse_mass[i]) * p.force[i];
+      spin_now_[i] = p.angular_velocity[i] + (half_step * p.inverse_inertia[i]) * p.torque[i];
+    }
+    return !added && neighbours_.moved_too_far(p.position, begin, end);
   });
+  return added || moved;
 }
 
 template <int D>

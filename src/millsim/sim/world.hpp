@@ -132,11 +132,15 @@ class World {
 
  private:
   // The stages of step(), in order.
-  void refresh_neighbours();
+  /// Makes a new neighbour list if `moved` (some particle has moved half a skin since the last
+  /// one: estimate_current_velocities says) or particles were added.
+  void refresh_neighbours(bool moved);
   /// The skin for the list about to be built: 2 skin_target_steps Δt |u̇|max, within
   /// [skin_floor, skin_ceiling<D>] of the smallest radius.
   double choose_skin() const;
-  void estimate_current_velocities();
+  /// u̇(n), ω(n) of every particle; returns whether some particle has moved more than half the
+  /// skin since the neighbour list was made, found in the same pass (or particles were added).
+  bool estimate_current_velocities();
   void evaluate_pair_contacts();
   /// The pairs of block `block` listed in `listed` (those that overlap or did until now), in
   /// pair order, lane_count at a time (core/lanes.hpp): their contacts are worked out side by
@@ -170,6 +174,10 @@ class World {
   /// on one thread, or split evenly if there are many particles but few pairs.
   template <class Body>
   void for_each_particle(Body&& body);
+  /// The same with body(begin, end) for runs of particles that together are all of them, once
+  /// each; returns whether any call returned true.
+  template <class Body>
+  bool for_each_particle_run(Body&& body);
   /// A wall contact of a candidate: where its history is, and what the contact law made of it.
   struct WallWork {
     std::uint32_t particle = 0;
