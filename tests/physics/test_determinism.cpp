@@ -321,5 +321,56 @@ TEST(Determinism, PeriodicSlab3DIsTheSameOnOneTwoAndThreeThreads) {
   expect_3d_scene_deterministic(true);
 }
 
+/// Steps a copy of `scene` `steps` times on two threads; halfway, sets one particle's velocity
+/// and spin through World::particles(). With `ask_every_step`, particles() is also asked for
+/// before every step, so that every step makes its velocity estimates from the particles
+/// instead of taking those the last step made (World::step).
+template <int D>
+Outcome<D> step_changing_halfway(const World<D>& scene, int steps, bool ask_every_step) {
+  const ThreadCount thread_count(2);
+  Outcome<D> outcome{scene, ImpactSpectrum{}, 2};
+  World<D>& world = outcome.world;
+  world.record_collisions_in(&outcome.spectrum);
+  for (int n = 0; n < steps; ++n) {
+    if (ask_every_step) {
+      static_cast<void>(world.particles());
+      EXPECT_FALSE(world.estimates_made()) << "particles() leaves the last step's estimates";
+    }
+    if (n == steps / 2) {
+      auto& p = world.particles();
+      const std::size_t i = p.size() / 2;
+      p.velocity[i] = -p.velocity[i];
+      p.angular_velocity[i] = 2.0 * p.angular_velocity[i];
+    }
+    world.step();
+    EXPECT_TRUE(world.estimates_made());
+  }
+  world.record_collisions_in(nullptr);
+  return outcome;
+}
+
+TEST(Determinism, StepsTakingTheLastStepsEstimatesGiveTheBitsOfStepsMakingThem) {
+  // A step takes the velocity estimates u(n), w(n) and the half-skin check that the last
+  // step's integration made, unless the particles were given out to be changed in between; then
+  // it makes them again. Both ways give the same bits, and a change between steps is seen: the
+  // periodic slab (the integration also wraps positions) and the 2D SAG scene.
+  const World<3> slab =
+      moving_scene<3>(plan_mill(parse_mill_config(short_wide_mill(true), "short-wide-mill.toml")),
+                      0.0, 1.0, 4.0, 200);
+  const Outcome<3> taken = step_changing_halfway(slab, 200, false);
+  const Outcome<3> made = step_changing_halfway(slab, 200, true);
+  expect_identical(taken, made);
+  EXPECT_GT(taken.world.neighbour_rebuilds(), slab.neighbour_rebuilds());
+  // The change halfway was seen: without it the slab ends elsewhere.
+  const Outcome<3> unchanged = step_on(slab, 200, 2);
+  EXPECT_NE(unchanged.world.kinetic_energy(), taken.world.kinetic_energy());
+
+  const MillPlan sag = plan_mill(load_mill_config(
+      std::string(MILLSIM_SOURCE_DIR) + "/bench/sag-12m-2d.toml", {"output.snapshot_interval=0"}));
+  const World<2> scene = moving_scene<2>(sag, 5.5, 0.7, 3.0, 200);
+  expect_identical(step_changing_halfway(scene, 200, false),
+                   step_changing_halfway(scene, 200, true));
+}
+
 }  // namespace
 }  // namespace millsim

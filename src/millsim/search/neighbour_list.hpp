@@ -46,6 +46,12 @@ class NeighbourList {
   /// Whether a particle among [begin, end) has moved more than half the skin since the last
   /// rebuild, for positions of the particles the list was built for (built_count()).
   bool moved_too_far(const std::vector<Vec<D>>& position, std::size_t begin, std::size_t end) const;
+  /// Whether particle i, now at x, has moved more than half the skin since the last rebuild.
+  bool moved_too_far(std::size_t i, const Vec<D>& x) const {
+    return norm_squared(separation(reference_position_[i], x)) > 0.25 * skin_ * skin_;
+  }
+  /// Where the particles were at the last rebuild.
+  const std::vector<Vec<D>>& reference_position() const { return reference_position_; }
   /// The number of particles the list was built for.
   std::size_t built_count() const { return reference_position_.size(); }
 

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstdio>
+#include <cstdlib>
 #include <type_traits>
 
 #include "millsim/core/vector_growth.hpp"
@@ -117,11 +119,17 @@ double World<D>::axial_period() const {
 
 template <int D>
 void World<D>::step() {
-  const bool moved = estimate_current_velocities();
+  bool moved = moved_half_skin_;
+  if (estimates_made_ && particles_.size() == neighbours_.built_count()) {
+    check_estimates_made();
+  } else {
+    moved = estimate_current_velocities();
+  }
   refresh_neighbours(moved);
   evaluate_pair_contacts();
   evaluate_wall_contacts();
-  accumulate_forces_and_integrate();
+  moved_half_skin_ = accumulate_forces_and_integrate();
+  estimates_made_ = true;
   advance_walls();
   time_ += settings_.time_step;
   ++steps_;
@@ -355,6 +363,27 @@ bool World<D>::estimate_current_velocities() {
     return !added && neighbours_.moved_too_far(p.position, begin, end);
   });
   return added || moved;
+}
+
+template <int D>
+void World<D>::check_estimates_made() const {
+#ifndef NDEBUG
+  const double half_step = 0.5 * settings_.time_step;
+  const auto& p = particles_;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Vec<D> velocity = p.velocity[i] + (half_step * p.inverse_mass[i]) * p.force[i];
+    const Spin<D> spin = p.angular_velocity[i] + (half_step * p.inverse_inertia[i]) * p.torque[i];
+    if (!(velocity == velocity_now_[i]) || !(spin == spin_now_[i]) ||
+        (neighbours_.moved_too_far(i, p.position[i]) && !moved_half_skin_)) {
+      std::fprintf(stderr,
+                   "millsim: World::step: particle %zu was changed after the last step through a "
+                   "reference to World::particles() kept from before it; ask particles() again "
+                   "after each step\n",
+                   i);
+      std::abort();
+    }
+  }
+#endif
 }
 
 template <int D>
@@ -977,34 +1006,59 @@ void World<D>::evaluate_wall_laws_in_lanes(WallWork* work, std::size_t count) {
 }
 
 template <int D>
-void World<D>::accumulate_forces_and_integrate() {
+bool World<D>::accumulate_forces_and_integrate() {
   // Each particle's forces are summed in a fixed order, so the sums are the same on every run
   // and thread count: its pairs in pair order, then walls (the pair and wall stages have added
   // them into force and torque), then gravity. Then the particle is advanced, in the same pass (one
   // read of its arrays instead of two): leapfrog u̇(n+½) = u̇(n−½) + ü(n) Δt,
-  // u(n+1) = u(n) + u̇(n+½) Δt; the same for rotation.
+  // u(n+1) = u(n) + u̇(n+½) Δt; the same for rotation. Still in the same pass, the next step's
+  // estimates u̇(n+1) ≈ u̇(n+½) + ½ ü(n) Δt (as estimate_current_velocities makes them), and
+  // whether the particle has moved half a skin since the neighbour list was made.
+  // The arrays by pointer, and the constants in locals: the compiler cannot tell that the
+  // stores below leave the vectors' and the list's members unchanged.
   auto& p = particles_;
-  auto& force = p.force;
-  auto& torque = p.torque;
-  const auto& m = p.mass;
+  Vec<D>* const force = p.force.data();
+  const Spin<D>* const torque = p.torque.data();
+  Vec<D>* const velocity = p.velocity.data();
+  Vec<D>* const position = p.position.data();
+  Spin<D>* const spin = p.angular_velocity.data();
+  const double* const mass = p.mass.data();
+  const double* const inverse_mass = p.inverse_mass.data();
+  const double* const inverse_inertia = p.inverse_inertia.data();
+  Vec<D>* const velocity_now = velocity_now_.data();
+  Spin<D>* const spin_now = spin_now_.data();
+  const Vec<D>* const reference = neighbours_.reference_position().data();
+  const double limit = 0.25 * neighbours_.skin() * neighbours_.skin();  // as moved_too_far
   const Vec<D> gravity = settings_.gravity;
   const double dt = settings_.time_step;
-  const std::size_t count = p.size();
-  for_each_particle([&](std::size_t i) {
-    force[i] += m[i] * gravity;
-    p.velocity[i] += (p.inverse_mass[i] * dt) * force[i];
-    p.position[i] += dt * p.velocity[i];
-    p.angular_velocity[i] += (p.inverse_inertia[i] * dt) * torque[i];
-  });
+  const double half_step = 0.5 * dt;
+  // Keeps positions in [0, period) along the axis of a periodic slab.
   const double period = neighbours_.period();
-  if (period > 0.0) {
-    // Keep positions in [0, period) along the periodic axis.
-    for (std::size_t i = 0; i < count; ++i) {
-      double& z = p.position[i][D - 1];
-      if (z < 0.0) z += period;
-      if (z >= period) z -= period;
+  // The loop compiled apart for a periodic slab, so that the other has no branch.
+  const auto integrate = [&](std::size_t begin, std::size_t end, auto periodic) {
+    bool moved = false;
+    for (std::size_t i = begin; i < end; ++i) {
+      force[i] += mass[i] * gravity;
+      velocity[i] += (inverse_mass[i] * dt) * force[i];
+      position[i] += dt * velocity[i];
+      spin[i] += (inverse_inertia[i] * dt) * torque[i];
+      Vec<D> offset = position[i] - reference[i];
+      if constexpr (periodic) {
+        double& z = position[i][D - 1];
+        if (z < 0.0) z += period;
+        if (z >= period) z -= period;
+        offset = neighbours_.separation(reference[i], position[i]);
+      }
+      velocity_now[i] = velocity[i] + (half_step * inverse_mass[i]) * force[i];
+      spin_now[i] = spin[i] + (half_step * inverse_inertia[i]) * torque[i];
+      moved |= norm_squared(offset) > limit;
     }
-  }
+    return moved;
+  };
+  return for_each_particle_run([&](std::size_t begin, std::size_t end) {
+    return period > 0.0 ? integrate(begin, end, std::true_type{})
+                        : integrate(begin, end, std::false_type{});
+  });
 }
 
 template <int D>

@@ -68,7 +68,14 @@ class World {
   /// The particles, in the order the step works on them. Particles are added at the end;
   /// with cell ordering on (set_cell_order_interval) they are renumbered at neighbour-list
   /// rebuilds, and a particle is known for good by its id, the index it was added at.
-  ParticleStore<D>& particles() { return particles_; }
+  /// Changes made through the reference are seen by the next step. Ask for it again after
+  /// every step() to change the particles: a step that follows another with no call here in
+  /// between takes the velocity estimates the last step made for it (debug builds check that
+  /// nothing changed, and stop if something did).
+  ParticleStore<D>& particles() {
+    estimates_made_ = false;
+    return particles_;
+  }
   const ParticleStore<D>& particles() const { return particles_; }
   /// The id of the particle at this index of particles().
   std::size_t particle_id(std::size_t index) const {
@@ -78,6 +85,9 @@ class World {
   std::size_t particle_index(std::size_t id) const {
     return id < particle_index_.size() ? particle_index_[id] : id;
   }
+  /// Whether the next step will take the velocity estimates the last step made (true after a
+  /// step, false once particles() has given the particles out to be changed).
+  bool estimates_made() const { return estimates_made_; }
   /// A copy of the particles in the order of their ids, as they were added.
   ParticleStore<D> particles_by_id() const;
 
@@ -140,7 +150,11 @@ class World {
   double choose_skin() const;
   /// u̇(n), ω(n) of every particle; returns whether some particle has moved more than half the
   /// skin since the neighbour list was made, found in the same pass (or particles were added).
+  /// Runs only when the last step has not made them (estimates_made_).
   bool estimate_current_velocities();
+  /// In debug builds, stops if the estimates the last step made differ from those of the
+  /// particles now (they were changed through a reference kept across steps).
+  void check_estimates_made() const;
   void evaluate_pair_contacts();
   /// The pairs of block `block` listed in `listed` (those that overlap or did until now), in
   /// pair order, lane_count at a time (core/lanes.hpp): their contacts are worked out side by
@@ -198,7 +212,9 @@ class World {
   void refresh_nearby_lifters();
   bool lifters_moved_too_far() const;
   void evaluate_wall_contacts();
-  void accumulate_forces_and_integrate();
+  /// Also makes the next step's velocity estimates, and returns whether some particle has moved
+  /// more than half the skin since the neighbour list was made.
+  bool accumulate_forces_and_integrate();
   void advance_walls();
 
   /// Puts every per-particle array in the new order: `previous[k]` is the index before of the
@@ -231,6 +247,12 @@ class World {
   // work the leapfrog update does (docs/model.md, "energy account").
   std::vector<Vec<D>> velocity_now_;
   std::vector<Spin<D>> spin_now_;
+  // Whether velocity_now_ and spin_now_ are those of the particles now, made by the last step's
+  // integration in the same pass (saving a pass over the particle arrays, which in 3D lie
+  // beyond the second-level cache), and whether a particle had then moved half a skin. Cleared
+  // when particles() gives the particles out to be changed.
+  bool estimates_made_ = false;
+  bool moved_half_skin_ = false;
 
   // A pair's contact in one step: the force on the second particle and the moment per unit
   // radius, −n × F_t, that both particles receive (scaled by their radii).
