@@ -357,8 +357,9 @@ bool World<D>::estimate_current_velocities() {
   const bool added = count != neighbours_.built_count();
   const bool moved = for_each_particle_run([&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      velocity_now_[i] = p.velocity[i] + (half_step * p.inverse_mass[i]) * p.force[i];
-      spin_now_[i] = p.angular_velocity[i] + (half_step * p.inverse_inertia[i]) * p.torque[i];
+      velocity_now_[i] = estimate_now(p.velocity[i], p.inverse_mass[i], p.force[i], half_step);
+      spin_now_[i] =
+          estimate_now(p.angular_velocity[i], p.inverse_inertia[i], p.torque[i], half_step);
     }
     return !added && neighbours_.moved_too_far(p.position, begin, end);
   });
@@ -371,8 +372,9 @@ void World<D>::check_estimates_made() const {
   const double half_step = 0.5 * settings_.time_step;
   const auto& p = particles_;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    const Vec<D> velocity = p.velocity[i] + (half_step * p.inverse_mass[i]) * p.force[i];
-    const Spin<D> spin = p.angular_velocity[i] + (half_step * p.inverse_inertia[i]) * p.torque[i];
+    const Vec<D> velocity = estimate_now(p.velocity[i], p.inverse_mass[i], p.force[i], half_step);
+    const Spin<D> spin =
+        estimate_now(p.angular_velocity[i], p.inverse_inertia[i], p.torque[i], half_step);
     if (!(velocity == velocity_now_[i]) || !(spin == spin_now_[i]) ||
         (neighbours_.moved_too_far(i, p.position[i]) && !moved_half_skin_)) {
       std::fprintf(stderr,
@@ -1049,8 +1051,8 @@ bool World<D>::accumulate_forces_and_integrate() {
         if (z >= period) z -= period;
         offset = neighbours_.separation(reference[i], position[i]);
       }
-      velocity_now[i] = velocity[i] + (half_step * inverse_mass[i]) * force[i];
-      spin_now[i] = spin[i] + (half_step * inverse_inertia[i]) * torque[i];
+      velocity_now[i] = estimate_now(velocity[i], inverse_mass[i], force[i], half_step);
+      spin_now[i] = estimate_now(spin[i], inverse_inertia[i], torque[i], half_step);
       moved |= norm_squared(offset) > limit;
     }
     return moved;

@@ -152,6 +152,13 @@ class World {
   /// skin since the neighbour list was made, found in the same pass (or particles were added).
   /// Runs only when the last step has not made them (estimates_made_).
   bool estimate_current_velocities();
+  /// The estimate at the time of the positions of a velocity (spin) known at the half step:
+  /// u̇(n) ≈ u̇(n−½) + ½ Δt F/m, with the last step's force (and ω the same way with the torque
+  /// and the inverse inertia). Written once for the three places that make it.
+  template <class V>
+  static V estimate_now(const V& half_step_value, double inverse, const V& sum, double half_step) {
+    return half_step_value + (half_step * inverse) * sum;
+  }
   /// In debug builds, stops if the estimates the last step made differ from those of the
   /// particles now (they were changed through a reference kept across steps).
   void check_estimates_made() const;
