@@ -166,6 +166,15 @@ TEST(ContactLanes, HelpersWorkLaneByLane) {
     EXPECT_EQ(chosen[l], x[l] > 0.0 ? x[l] : 7.0);
     EXPECT_EQ(gathered[l], 10.0 * static_cast<double>(l));
   }
+  // any: whether the mask holds in some lane, for each lane alone and for none.
+  EXPECT_FALSE(any(x > 100.0));
+  for (std::size_t l = 0; l < lanes; ++l) {
+    Lanes one{};
+    one[l] = 1.0;
+    EXPECT_TRUE(any(one > 0.0)) << "lane " << l;
+  }
+  EXPECT_TRUE(any(true));
+  EXPECT_FALSE(any(false));
   // Spins: a number per lane in 2D, a vector per lane in 3D.
   const Lanes spin_2d = gather_spin_lanes<2>([](std::size_t l) { return static_cast<double>(l); });
   const Vec<3, Lanes> spin_3d = gather_spin_lanes<3>([](std::size_t l) {

@@ -102,7 +102,12 @@ class LinearSpringDashpot {
     // springs; what they held is lost.
     const Mask<T> breaks = allow_tension_ ? Mask<T>{} : normal_force <= 0.0;
     const T held = select(T{} < normal_spring, normal_spring, T{});  // max(0, spring)
-    const T broken_dissipated = held * held / (2.0 * k_n) + norm_squared(spring) / (2.0 * k_s);
+    // Worked out only where some contact breaks, which few do in a step: its two divisions cost
+    // as much as the rest of the law's arithmetic (the divider is what the law waits on).
+    T broken_dissipated{};
+    if (any(breaks)) {
+      broken_dissipated = held * held / (2.0 * k_n) + norm_squared(spring) / (2.0 * k_s);
+    }
     const T dashpot_dissipated = normal_damping * normal_speed * normal_speed * dt;  // |D_n·v_n| Δt
 
     // Tangential spring F_s ← R(F_s) − k_s v_s Δt, dashpot D_s = −c_s v_s. Coulomb: when the

@@ -36,6 +36,17 @@ template <class M, int D, class T>
   return r;
 }
 
+/// Whether the mask holds in any lane (for bool, the mask itself).
+[[gnu::always_inline]] inline bool any(bool mask) {
+  return mask;
+}
+template <class M>
+[[gnu::always_inline]] inline bool any(M mask) {
+  auto bits = mask[0];
+  for (int l = 1; l < lane_count; ++l) bits |= mask[l];
+  return bits != 0;
+}
+
 /// Square root and absolute value, exact in every lane as std::sqrt and std::abs are.
 [[gnu::always_inline]] inline double lane_sqrt(double x) {
   return __builtin_sqrt(x);
