@@ -137,8 +137,8 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
     // its own: all it can find is another of its radius in a later slot, and it looks at those
     // alone (half the search in a mill of one ball size).
     const double smallest_radius = *smallest;
-    const auto search_from = [&](std::size_t slot,
-                                 std::vector<std::pair<std::uint32_t, std::uint32_t>>& found) {
+    // The pairs go to found[0, n), found kept long enough to take every partner looked at.
+    const auto search_from = [&](std::size_t slot, std::vector<FoundPair>& found, std::size_t& n) {
       const std::uint32_t i = cell_members_[slot];
       const double own_radius = cell_radius_[slot];
       const std::uint32_t first_slot =
@@ -172,15 +172,21 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
         const std::uint32_t begin =
             std::max(first_slot, cell_start_[row + static_cast<std::size_t>(from[0])]);
         const std::uint32_t end = cell_start_[row + static_cast<std::size_t>(to[0]) + 1];
+        if (end <= begin) return;
+        if (found.size() < n + (end - begin))
+          found.resize(std::max(2 * found.size(), n + (end - begin)));
+        // Without a branch: every partner is written and kept only if it is found, as which
+        // partners are (a third of those looked at in the 2D SAG scene) cannot be predicted.
         for (std::uint32_t k = begin; k < end; ++k) {
           const double other_radius = cell_radius_[k];
-          if (other_radius > own_radius) continue;
-          if (other_radius == own_radius && k <= slot) continue;
+          const bool searched_here =
+              other_radius < own_radius || (other_radius == own_radius && k > slot);
           const std::uint32_t j = cell_members_[k];
           const double reach = own_radius + other_radius + skin_;
-          if (norm_squared(separation(own_position, cell_position_[k])) < reach * reach) {
-            found.push_back(i < j ? std::pair{i, j} : std::pair{j, i});
-          }
+          const bool near =
+              norm_squared(separation(own_position, cell_position_[k])) < reach * reach;
+          found[n] = FoundPair(std::min(i, j), std::max(i, j));
+          n += static_cast<std::size_t>(searched_here & near);
         }
       };
       const auto wrap = [&](long c, int a) {
@@ -208,12 +214,13 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
     if (found_.size() < chunks) found_.resize(chunks);
 #pragma omp parallel for schedule(dynamic) if (count >= parallel_search_threshold)
     for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
-      std::vector<std::pair<std::uint32_t, std::uint32_t>>& found = found_[chunk];
-      found.clear();
+      std::vector<FoundPair>& found = found_[chunk];
+      std::size_t n = 0;
       const std::size_t chunk_end = std::min(count, (chunk + 1) * search_chunk);
       for (std::size_t member = chunk * search_chunk; member < chunk_end; ++member) {
-        search_from(member, found);
+        search_from(member, found, n);
       }
+      found.resize(n);
     }
     // Sorted by (first, second): a counting sort by first, then each first's seconds.
     pair_cursor_.assign(count + 1, 0);

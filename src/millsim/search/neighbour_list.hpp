@@ -98,7 +98,15 @@ class NeighbourList {
   std::vector<std::uint32_t> next_first_, next_second_;
   std::vector<std::array<long, D>> particle_home_;
   std::vector<std::uint32_t> previous_index_;
-  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found_;  // per search chunk
+  /// A pair found by the search, lower index first. Its empty constructor leaves it unset, so
+  /// that growing a chunk's list of found pairs does not write the new entries twice.
+  struct FoundPair {
+    FoundPair() {}  // NOLINT(modernize-use-equals-default): = default would zero the entries
+    FoundPair(std::uint32_t a, std::uint32_t b) : first(a), second(b) {}
+    std::uint32_t first;
+    std::uint32_t second;
+  };
+  std::vector<std::vector<FoundPair>> found_;  // per search chunk
   std::vector<std::uint32_t> pair_cursor_;
   std::vector<ContactHistory<D>> next_history_;
   std::vector<TouchState> next_touching_;
