@@ -1059,7 +1059,9 @@ bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
   // Keeps positions in [0, period) along the axis of a periodic slab.
   const double period = neighbours_.period();
   unsigned moved = 0;
+#if !defined(__clang__)  // GCC's; `omp simd` left this loop unvectorised
 #pragma GCC ivdep
+#endif
   for (std::size_t i = begin; i < end; ++i) {
     force[i] += mass[i] * gravity;
     velocity[i] += (inverse_mass[i] * dt) * force[i];
