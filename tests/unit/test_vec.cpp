@@ -1,5 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
 #include "millsim/core/vec.hpp"
 
 namespace millsim {
@@ -22,6 +28,44 @@ TEST(Vec, PlaneCrossProductsFollowTheRightHandRule) {
   const Vec3 x3{{1.0, 0.0, 0.0}};
   const Vec3 y3{{0.0, 1.0, 0.0}};
   EXPECT_EQ(cross(x3, y3), (Vec3{{0.0, 0.0, 1.0}}));
+}
+
+TEST(Vec, NearestIntegerHasTheBitsOfNearbyint) {
+  // Random values over the range a periodic slab meets and far beyond, exact halves (ties go to
+  // even), signed zeros, values about 2^52 and 2^53, and the non-finite.
+  std::vector<double> values{0.0,
+                             -0.0,
+                             0.5,
+                             -0.5,
+                             1.5,
+                             -1.5,
+                             2.5,
+                             -2.5,
+                             0.49999999999999994,
+                             -0.3,
+                             1e-300,
+                             -1e-300,
+                             4503599627370495.5,
+                             -4503599627370495.5,
+                             4503599627370496.0,
+                             4503599627370497.0,
+                             9007199254740993.0,
+                             1e300,
+                             std::numeric_limits<double>::infinity(),
+                             -std::numeric_limits<double>::infinity()};
+  for (int k = -40; k <= 40; ++k) values.push_back(k + 0.5);
+  std::mt19937_64 random(7);
+  for (const double scale : {1.0, 10.0, 1e6, 1e15, 1e17}) {
+    std::uniform_real_distribution<double> uniform(-scale, scale);
+    for (int k = 0; k < 10000; ++k) values.push_back(uniform(random));
+  }
+  for (const double t : values) {
+    const double expected = std::nearbyint(t);
+    const double got = nearest_integer(t);
+    EXPECT_EQ(std::memcmp(&expected, &got, sizeof got), 0)
+        << "t = " << t << ": nearbyint " << expected << ", nearest_integer " << got;
+  }
+  EXPECT_TRUE(std::isnan(nearest_integer(std::numeric_limits<double>::quiet_NaN())));
 }
 
 }  // namespace

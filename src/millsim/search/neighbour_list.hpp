@@ -36,7 +36,7 @@ class NeighbourList {
   /// b − a, along the periodic axis the nearest image's.
   Vec<D> separation(const Vec<D>& a, const Vec<D>& b) const {
     Vec<D> offset = b - a;
-    if (period_ > 0.0) offset[D - 1] -= period_ * std::nearbyint(offset[D - 1] / period_);
+    if (period_ > 0.0) offset[D - 1] -= period_ * nearest_integer(offset[D - 1] / period_);
     return offset;
   }
 

@@ -222,7 +222,7 @@ World<D> build_mill_world(const MillPlan& plan) {
   };
   const auto separation = [&](const Vec<D>& from, const Vec<D>& to) {
     Vec<D> offset = to - from;
-    if (periodic) offset[D - 1] -= period * std::nearbyint(offset[D - 1] / period);
+    if (periodic) offset[D - 1] -= period * nearest_integer(offset[D - 1] / period);
     return offset;
   };
   auto& particles = world.particles();
