@@ -1067,11 +1067,16 @@ bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
     velocity[i] += (inverse_mass[i] * dt) * force[i];
     position[i] += dt * velocity[i];
     spin[i] += (inverse_inertia[i] * dt) * torque[i];
-    Vec<D> offset = position[i] - reference[i];
     if constexpr (periodic) {
       double& z = position[i][D - 1];
-      if (z < 0.0) z += period;
-      if (z >= period) z -= period;
+      z = z < 0.0 ? z + period : z;
+      z = z >= period ? z - period : z;
+    }
+    Vec<D> offset = position[i] - reference[i];
+    // Along a periodic axis, the nearest image's offset: the same but for the rare particle
+    // that has crossed an end since the list was made (below 0.49 periods the nearest integer
+    // of offset / period is ±0, and the wrapped offset's square the same bits).
+    if (periodic && std::fabs(offset[D - 1]) >= 0.49 * period) {
       offset = neighbours_.separation(reference[i], position[i]);
     }
     velocity_now[i] = estimate_now(velocity[i], inverse_mass[i], force[i], half_step);
