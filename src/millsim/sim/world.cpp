@@ -1022,7 +1022,9 @@ bool World<D>::accumulate_forces_and_integrate() {
 #if defined(__x86_64__)
     // In 2D only: a sphere's three components do not pair up in registers, and the 3D loop
     // ran slower so (bench/results.md).
-    if (D == 2 && avx2_lanes_) return integrate_particles_avx2(begin, end);
+    if constexpr (D == 2) {
+      if (avx2_lanes_) return integrate_particles_avx2(begin, end);
+    }
 #endif
     return integrate_particles<false>(begin, end);
   });
@@ -1030,7 +1032,7 @@ bool World<D>::accumulate_forces_and_integrate() {
 
 #if defined(__x86_64__)
 template <int D>
-bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
+bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) requires(D == 2) {
   return integrate_particles<false>(begin, end);
 }
 #endif

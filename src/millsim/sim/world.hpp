@@ -222,12 +222,13 @@ class World {
   /// Also makes the next step's velocity estimates, and returns whether some particle has moved
   /// more than half the skin since the neighbour list was made.
   bool accumulate_forces_and_integrate();
-  /// Its loop over particles [begin, end), for a periodic slab or not; the one without a
+  /// Its loop over particles [begin, end), for a periodic slab or not. In 2D the one without a
   /// period is compiled twice, for processors with AVX2 (two discs in a register, where the
   /// other works on one) and for any x86-64, the same bits either way.
   template <bool periodic>
   [[gnu::always_inline]] inline bool integrate_particles(std::size_t begin, std::size_t end);
-  __attribute__((target("avx2"))) bool integrate_particles_avx2(std::size_t begin, std::size_t end);
+  __attribute__((target("avx2"))) bool integrate_particles_avx2(std::size_t begin,
+                                                                std::size_t end) requires(D == 2);
   void advance_walls();
 
   /// Puts every per-particle array in the new order: `previous[k]` is the index before of the
