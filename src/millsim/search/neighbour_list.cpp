@@ -25,13 +25,13 @@ bool NeighbourList<D>::needs_refresh(const std::vector<Vec<D>>& position) const 
 template <int D>
 bool NeighbourList<D>::moved_too_far(const std::vector<Vec<D>>& position, std::size_t begin,
                                      std::size_t end) const {
-  const double limit = 0.25 * skin_ * skin_;  // (skin / 2)²
+  const double limit = half_skin_squared();
   // Every step asks, and the answer is almost always no: every particle is looked at, without
   // a branch, so that the compiler can work on several at once.
   bool moved = false;
   if (period_ > 0.0) {
     for (std::size_t i = begin; i < end; ++i) {
-      moved |= norm_squared(separation(reference_position_[i], position[i])) > limit;
+      moved |= norm_squared(displacement(reference_position_[i], position[i])) > limit;
     }
     return moved;
   }

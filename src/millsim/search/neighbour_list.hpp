@@ -48,7 +48,20 @@ class NeighbourList {
   bool moved_too_far(const std::vector<Vec<D>>& position, std::size_t begin, std::size_t end) const;
   /// Whether particle i, now at x, has moved more than half the skin since the last rebuild.
   bool moved_too_far(std::size_t i, const Vec<D>& x) const {
-    return norm_squared(separation(reference_position_[i], x)) > 0.25 * skin_ * skin_;
+    return norm_squared(displacement(reference_position_[i], x)) > half_skin_squared();
+  }
+  /// (skin / 2)²: a particle that has moved further since the last rebuild calls for the next.
+  double half_skin_squared() const { return 0.25 * skin_ * skin_; }
+  /// x − reference, along the periodic axis the nearest image's, for a particle now at x that
+  /// was at reference when the list was made: separation(reference, x), without its division
+  /// but for the rare particle that has crossed an end since (below 0.49 periods the nearest
+  /// integer of the offset / period is ±0, and the square of the plain offset the same bits).
+  Vec<D> displacement(const Vec<D>& reference, const Vec<D>& x) const {
+    const Vec<D> offset = x - reference;
+    if (period_ > 0.0 && std::fabs(offset[D - 1]) >= 0.49 * period_) {
+      return separation(reference, x);
+    }
+    return offset;
   }
   /// Where the particles were at the last rebuild.
   const std::vector<Vec<D>>& reference_position() const { return reference_position_; }

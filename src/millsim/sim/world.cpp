@@ -1054,7 +1054,7 @@ bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
   Vec<D>* const velocity_now = velocity_now_.data();
   Spin<D>* const spin_now = spin_now_.data();
   const Vec<D>* const reference = neighbours_.reference_position().data();
-  const double limit = 0.25 * neighbours_.skin() * neighbours_.skin();  // as moved_too_far
+  const double limit = neighbours_.half_skin_squared();
   const Vec<D> gravity = settings_.gravity;
   const double dt = settings_.time_step;
   const double half_step = 0.5 * dt;
@@ -1074,13 +1074,9 @@ bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
       z = z < 0.0 ? z + period : z;
       z = z >= period ? z - period : z;
     }
-    Vec<D> offset = position[i] - reference[i];
-    // Along a periodic axis, the nearest image's offset: the same but for the rare particle
-    // that has crossed an end since the list was made (below 0.49 periods the nearest integer
-    // of offset / period is ±0, and the wrapped offset's square the same bits).
-    if (periodic && std::fabs(offset[D - 1]) >= 0.49 * period) {
-      offset = neighbours_.separation(reference[i], position[i]);
-    }
+    // As NeighbourList::moved_too_far asks it (the plain difference where no axis is periodic).
+    const Vec<D> offset =
+        periodic ? neighbours_.displacement(reference[i], position[i]) : position[i] - reference[i];
     velocity_now[i] = estimate_now(velocity[i], inverse_mass[i], force[i], half_step);
     spin_now[i] = estimate_now(spin[i], inverse_inertia[i], torque[i], half_step);
     moved |= norm_squared(offset) > limit ? 1U : 0U;
