@@ -321,6 +321,48 @@ TEST(Determinism, PeriodicSlab3DIsTheSameOnOneTwoAndThreeThreads) {
   expect_3d_scene_deterministic(true);
 }
 
+TEST(Determinism, StagesSplitThreeWaysButRunByOneThreadGiveTheSameBits) {
+  // World::step splits the particles among as many runs as OpenMP offers threads, and each
+  // thread takes its runs in turn; a wall block whose candidates two runs share is done by
+  // whichever of them comes to it first. Stepped from inside another parallel region, with
+  // nesting off, the step's regions get one thread, which goes through all three runs itself
+  // (and so does each shared block at the end of the earlier run instead of at the start of the
+  // later one, as three threads do). The 3D mill with end plates: thousands of wall candidates,
+  // so the runs' boundaries fall inside wall blocks.
+  const MillPlan plan =
+      plan_mill(parse_mill_config(short_wide_mill(false), "short-wide-mill.toml"));
+  const World<3> scene = moving_scene<3>(plan, 0.0, 1.0, 4.0, 200);
+  const Outcome<3> one = step_on(scene, 200, 1);
+  Outcome<3> nested{scene, ImpactSpectrum{}, 3};
+  {
+    const ThreadCount thread_count(3);
+    const int levels = omp_get_max_active_levels();
+    omp_set_max_active_levels(1);
+    nested.world.record_collisions_in(&nested.spectrum);
+    int inner_team = 0;
+    int inner_threads = 0;
+#pragma omp parallel num_threads(2)
+    {
+      if (omp_get_thread_num() == 0) {
+        inner_threads = omp_get_max_threads();
+#pragma omp parallel
+        {
+#pragma omp single
+          inner_team = omp_get_num_threads();
+        }
+        for (int n = 0; n < 200; ++n) nested.world.step();
+      }
+    }
+    nested.world.record_collisions_in(nullptr);
+    omp_set_max_active_levels(levels);
+    EXPECT_EQ(inner_threads, 3) << "the step splits its work three ways";
+    EXPECT_EQ(inner_team, 1) << "a nested region gets one thread";
+  }
+  expect_identical(one, nested);
+  EXPECT_GT(wall_candidates(one.world), parallel_threshold);
+  EXPECT_GT(listed_pairs(one.world), parallel_pair_threshold);
+}
+
 /// Steps a copy of `scene` `steps` times on two threads; halfway, sets one particle's velocity
 /// and spin through World::particles(). With `ask_every_step`, particles() is also asked for
 /// before every step, so that every step makes its velocity estimates from the particles

@@ -3,9 +3,12 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <memory>
 #include <type_traits>
 
 #include "millsim/core/vector_growth.hpp"
@@ -126,9 +129,15 @@ void World<D>::step() {
     moved = estimate_current_velocities();
   }
   refresh_neighbours(moved);
-  evaluate_pair_contacts();
-  evaluate_wall_contacts();
-  moved_half_skin_ = accumulate_forces_and_integrate();
+  if (stages_on_one_thread()) {
+    moved_half_skin_ = run_stages_in_one_pass();
+  } else if (particles_.size() == neighbours_.built_count() && pairs_split_among_threads()) {
+    moved_half_skin_ = run_stages_split_among_threads();
+  } else {
+    evaluate_pair_contacts();
+    evaluate_wall_contacts();
+    moved_half_skin_ = accumulate_forces_and_integrate();
+  }
   estimates_made_ = true;
   advance_walls();
   time_ += settings_.time_step;
@@ -464,11 +473,7 @@ void World<D>::split_pairs_among(int threads) {
 }
 
 template <int D>
-void World<D>::evaluate_pair_contacts() {
-  const auto& first = neighbours_.first();
-  const auto& second = neighbours_.second();
-  auto& history = neighbours_.history();
-  auto& touching = neighbours_.touching();
+typename World<D>::PairOutcome World<D>::evaluate_pair(std::size_t q, PairForce& out) {
   const auto& x = particles_.position;
   const auto& v = velocity_now_;
   const auto& w = spin_now_;
@@ -476,183 +481,89 @@ void World<D>::evaluate_pair_contacts() {
   const auto& step_w = particles_.angular_velocity;
   const auto& r = particles_.radius;
   const auto& m = particles_.mass;
-  const double dt = settings_.time_step;
-  const std::size_t pairs = first.size();
-  const std::size_t blocks = pair_block_ended_.size();
-  auto& force = particles_.force;
-  auto& torque = particles_.torque;
+  auto& history = neighbours_.history();
+  auto& touching = neighbours_.touching();
+  const std::uint32_t i = neighbours_.first()[q];
+  const std::uint32_t j = neighbours_.second()[q];
+  const Vec<D> offset = neighbours_.separation(x[i], x[j]);
+  const double distance_squared = norm_squared(offset);
+  const double reach = r[i] + r[j];
+  if (distance_squared >= reach * reach) {
+    if (touching[q] == TouchState::apart) return {PairStatus::apart, 0.0};
+    const double energy = history[q].dissipated;
+    history[q] = ContactHistory<D>{};
+    touching[q] = TouchState::apart;
+    return {PairStatus::ended, energy};
+  }
+  const double distance = std::sqrt(distance_squared);
+  ContactInput<D> in;
+  in.normal = offset * (1.0 / distance);
+  in.overlap = reach - distance;
+  in.velocity = v[j] - v[i];
+  in.spin_velocity = cross(in.normal, r[i] * w[i] + r[j] * w[j]);
+  in.step_velocity = step_v[j] - step_v[i];
+  in.step_spin_velocity = cross(in.normal, r[i] * step_w[i] + r[j] * step_w[j]);
+  touching[q] = TouchState::touching;
+  history[q].overlap = in.overlap;
+  // The dashpots' coefficients from the pair's effective mass, worked out here rather than
+  // read from a per-pair array made at each rebuild, whose entries, read only for the few
+  // listed pairs that touch, missed the cache.
+  const ContactDamping damping = ball_ball_law_.damping(m[i] * m[j] / (m[i] + m[j]));
+  const ContactOutput<D> result =
+      ball_ball_law_.evaluate(in, damping, history[q], settings_.time_step);
+  out = {result.force, -cross(in.normal, result.tangential_force)};
+  return {PairStatus::touching, result.dissipated};
+}
 
-  // Pair q: its contact this step. Writes the force on the second particle and the moment both
-  // receive (scaled by their radii) to `out` if the pair touches, and returns what happened.
-  const auto evaluate = [&](std::size_t q, PairForce & out) __attribute__((always_inline))
-                            ->PairOutcome {
-    const std::uint32_t i = first[q];
-    const std::uint32_t j = second[q];
-    const Vec<D> offset = neighbours_.separation(x[i], x[j]);
-    const double distance_squared = norm_squared(offset);
-    const double reach = r[i] + r[j];
-    if (distance_squared >= reach * reach) {
-      if (touching[q] == TouchState::apart) return {PairStatus::apart, 0.0};
-      const double energy = history[q].dissipated;
-      history[q] = ContactHistory<D>{};
-      touching[q] = TouchState::apart;
-      return {PairStatus::ended, energy};
-    }
-    const double distance = std::sqrt(distance_squared);
-    ContactInput<D> in;
-    in.normal = offset * (1.0 / distance);
-    in.overlap = reach - distance;
-    in.velocity = v[j] - v[i];
-    in.spin_velocity = cross(in.normal, r[i] * w[i] + r[j] * w[j]);
-    in.step_velocity = step_v[j] - step_v[i];
-    in.step_spin_velocity = cross(in.normal, r[i] * step_w[i] + r[j] * step_w[j]);
-    touching[q] = TouchState::touching;
-    history[q].overlap = in.overlap;
-    // The dashpots' coefficients from the pair's effective mass, worked out here rather than
-    // read from a per-pair array made at each rebuild, whose entries, read only for the few
-    // listed pairs that touch, missed the cache.
-    const ContactDamping damping = ball_ball_law_.damping(m[i] * m[j] / (m[i] + m[j]));
-    const ContactOutput<D> result = ball_ball_law_.evaluate(in, damping, history[q], dt);
-    out = {result.force, -cross(in.normal, result.tangential_force)};
-    return {PairStatus::touching, result.dissipated};
-  };
-  // Adds a touching pair's force and moment to its particles: −F on the first, +F on the
-  // second.
-  const auto add_to_first = [&](std::size_t q, const PairForce& f) {
-    const std::uint32_t i = first[q];
-    force[i] -= f.force;
-    torque[i] += r[i] * f.moment;
-  };
-  const auto add_to_second = [&](std::size_t q, const PairForce& f) {
-    const std::uint32_t j = second[q];
-    force[j] += f.force;
-    torque[j] += r[j] * f.moment;
-  };
-
-  // Block b, all of it, on one thread: each pair's force added in pair order, the block's
-  // dissipation summed and its ended collisions listed in pair order.
-  const auto whole_block = [&](std::size_t b) {
-    double dissipated = 0.0;
-    std::uint32_t ended = 0;
-    const std::size_t begin = b * pair_block;
-    const std::size_t end = std::min(pairs, begin + pair_block);
-    // Pairs that overlap now or did until now, in pair order: the rest need nothing. Listed
-    // without a branch (a third of the 2D SAG scene's listed pairs touch, scattered among the
-    // others, which the processor could only mispredict).
-    std::array<std::uint32_t, pair_block> listed;
-    std::size_t count = 0;
-    for (std::size_t q = begin; q < end; ++q) {
-      const Vec<D> offset = neighbours_.separation(x[first[q]], x[second[q]]);
-      const double reach = r[first[q]] + r[second[q]];
-      const unsigned overlaps = norm_squared(offset) < reach * reach ? 1U : 0U;
-      const unsigned touched = touching[q] == TouchState::touching ? 1U : 0U;
-      listed[count] = static_cast<std::uint32_t>(q);
-      count += overlaps | touched;
-    }
-    evaluate_listed_pairs(b, listed.data(), count, dissipated, ended);
-    pair_block_dissipated_[b] = dissipated;
-    pair_block_ended_[b] = ended;
-  };
+template <int D>
+void World<D>::evaluate_pair_contacts() {
   // Each particle sums its pairs in pair order (pairs where it is second come first, as their
   // first particle has the lower index): the order in which one thread going down the list
-  // meets them. On one thread the pairs add their forces to the particles as they go.
-  if (!pairs_split_among_threads()) {
-    std::fill(force.begin(), force.end(), Vec<D>{});
-    std::fill(torque.begin(), torque.end(), Spin<D>{});
-    for (std::size_t b = 0; b < blocks; ++b) whole_block(b);
-  } else {
-    // Several threads give the same sums in the same order. Thread t owns a run of particles
-    // and the pairs whose first particle is one of them (split_pairs_among). A pair whose second
-    // particle belongs to a later thread (a cross pair: 1.5 % of the 3D 20 k scene's on two
-    // threads) is evaluated first, before a barrier; then each thread zeroes its particles, adds
-    // the cross pairs' forces to their second particles (they come before any of its own pairs in
-    // pair order), and goes down its own pairs, adding each one's force to both particles, or, for
-    // a cross pair, the stored force to the first. A block of pairs that lies in one thread's run
-    // and holds no cross pair is gone through as on one thread (whole_block); in the others
-    // (mixed_blocks_: at most a few per thread) each pair's dissipation and end are kept apart
-    // and summed afterwards, in the same order. Keeping every pair's apart cost a third more
-    // instructions per pair (callgrind, the 2D SAG scene).
-    pair_status_.resize(pairs);
-    pair_energy_.resize(pairs);
-    const std::size_t crossing = cross_pairs_.size();
-    const auto ranges = static_cast<std::size_t>(split_threads_);
-#pragma omp parallel num_threads(split_threads_)
-    {
-#pragma omp for schedule(static)
-      for (std::size_t c = 0; c < crossing; ++c) {
-        const std::uint32_t q = cross_pairs_[c];
-        const PairOutcome outcome = evaluate(q, cross_force_[c]);
-        pair_status_[q] = outcome.status;
-        pair_energy_[q] = outcome.energy;
-      }
-      // The implicit barrier of the loop above: every cross pair's force is known.
-      const auto team = static_cast<std::size_t>(omp_get_num_threads());
-      for (auto t = static_cast<std::size_t>(omp_get_thread_num()); t < ranges; t += team) {
-        const std::uint32_t own_begin = split_particle_[t];
-        const std::uint32_t own_end = split_particle_[t + 1];
-        for (std::uint32_t i = own_begin; i < own_end; ++i) {
-          force[i] = Vec<D>{};
-          torque[i] = Spin<D>{};
-        }
-        for (std::size_t c = 0; c < crossing; ++c) {
-          const std::uint32_t q = cross_pairs_[c];
-          const std::uint32_t j = second[q];
-          if (j >= own_begin && j < own_end && pair_status_[q] == PairStatus::touching) {
-            add_to_second(q, cross_force_[c]);
-          }
-        }
-        std::size_t c = static_cast<std::size_t>(
-            std::lower_bound(cross_pairs_.begin(), cross_pairs_.end(), split_pair_[t]) -
-            cross_pairs_.begin());
-        std::size_t q = split_pair_[t];
-        while (q < split_pair_[t + 1]) {
-          const std::size_t b = q / pair_block;
-          if (!block_mixed_[b]) {
-            whole_block(b);  // which starts at q and ends in this run
-            q = std::min(pairs, (b + 1) * pair_block);
-            continue;
-          }
-          const std::size_t end = std::min<std::size_t>(split_pair_[t + 1], (b + 1) * pair_block);
-          for (; q < end; ++q) {
-            if (second[q] >= own_end) {
-              if (pair_status_[q] == PairStatus::touching) add_to_first(q, cross_force_[c]);
-              ++c;
-              continue;
-            }
-            PairForce f;
-            const PairOutcome outcome = evaluate(q, f);
-            pair_status_[q] = outcome.status;
-            pair_energy_[q] = outcome.energy;
-            if (outcome.status == PairStatus::touching) {
-              add_to_first(q, f);
-              add_to_second(q, f);
-            }
-          }
-        }
-      }
-#pragma omp barrier
-      const std::size_t mixed = mixed_blocks_.size();
-#pragma omp for schedule(static)
-      for (std::size_t k = 0; k < mixed; ++k) {
-        const std::size_t b = mixed_blocks_[k];
-        double dissipated = 0.0;
-        std::uint32_t ended = 0;
-        const std::size_t end = std::min(pairs, (b + 1) * pair_block);
-        for (std::size_t q = b * pair_block; q < end; ++q) {
-          if (pair_status_[q] == PairStatus::touching) {
-            dissipated += pair_energy_[q];
-          } else if (pair_status_[q] == PairStatus::ended) {
-            pair_ended_[b * pair_block + ended++] = {ContactType::ball_ball, pair_energy_[q]};
-          }
-        }
-        pair_block_dissipated_[b] = dissipated;
-        pair_block_ended_[b] = ended;
-      }
-    }
-  }
+  // meets them. The pairs add their forces to the particles as they go.
+  std::fill(particles_.force.begin(), particles_.force.end(), Vec<D>{});
+  std::fill(particles_.torque.begin(), particles_.torque.end(), Spin<D>{});
+  const std::size_t blocks = pair_block_ended_.size();
+  for (std::size_t b = 0; b < blocks; ++b) evaluate_pair_block(b);
+  finish_pair_stage();
+}
+
+template <int D>
+void World<D>::finish_pair_stage() {
   last_step_dissipation_ = 0.0;
   for (const double d : pair_block_dissipated_) last_step_dissipation_ += d;
   record_ended(pair_ended_, pair_block_ended_, pair_block);
+}
+
+template <int D>
+void World<D>::evaluate_pair_block(std::size_t b) {
+  // Block b, all of it, on one thread: each pair's force added in pair order, the block's
+  // dissipation summed and its ended collisions listed in pair order.
+  const auto& first = neighbours_.first();
+  const auto& second = neighbours_.second();
+  const auto& touching = neighbours_.touching();
+  const auto& x = particles_.position;
+  const auto& r = particles_.radius;
+  const std::size_t pairs = first.size();
+  double dissipated = 0.0;
+  std::uint32_t ended = 0;
+  const std::size_t begin = b * pair_block;
+  const std::size_t end = std::min(pairs, begin + pair_block);
+  // Pairs that overlap now or did until now, in pair order: the rest need nothing. Listed
+  // without a branch (a third of the 2D SAG scene's listed pairs touch, scattered among the
+  // others, which the processor could only mispredict).
+  std::array<std::uint32_t, pair_block> listed;
+  std::size_t count = 0;
+  for (std::size_t q = begin; q < end; ++q) {
+    const Vec<D> offset = neighbours_.separation(x[first[q]], x[second[q]]);
+    const double reach = r[first[q]] + r[second[q]];
+    const unsigned overlaps = norm_squared(offset) < reach * reach ? 1U : 0U;
+    const unsigned touched = touching[q] == TouchState::touching ? 1U : 0U;
+    listed[count] = static_cast<std::uint32_t>(q);
+    count += overlaps | touched;
+  }
+  evaluate_listed_pairs(b, listed.data(), count, dissipated, ended);
+  pair_block_dissipated_[b] = dissipated;
+  pair_block_ended_[b] = ended;
 }
 
 template <int D>
@@ -800,118 +711,18 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
 
 template <int D>
 void World<D>::evaluate_wall_contacts() {
-  const double dt = settings_.time_step;
   const std::size_t candidates = wall_candidates_.size();
   const std::size_t blocks = wall_block_ended_.size();
-  const auto wall_block_stage = [&](std::size_t b) {
-    double torque = 0.0;
-    double work = 0.0;
-    double dissipated = 0.0;
-    std::uint32_t ended = 0;
-    EndedCollision* block_ended = &wall_ended_[b * wall_block * max_wall_contacts];
-    const std::size_t begin = b * wall_block;
-    const std::size_t end = std::min(candidates, begin + wall_block);
-    // The block's contacts, found candidate by candidate (each in its slot of wall-contact
-    // history), then their contact law worked out lane_count at a time, then each candidate's
-    // contacts added up in the order they were found. One list per thread, kept.
-    static thread_local std::vector<WallWork> work_list;
-    static thread_local std::vector<std::uint32_t> first_work;
-    work_list.clear();
-    first_work.assign(end - begin + 1, 0);
-    for (std::size_t k = begin; k < end; ++k) {
-      const std::uint32_t i = wall_candidates_[k];
-      std::int32_t* slot_id = &wall_slot_id_[k * max_wall_contacts];
-      ContactHistory<D>* slot_history = &wall_slot_history_[k * max_wall_contacts];
-      unsigned seen = 0;  // bit s: slot s touched now
-      const NearbyLifters* nearby = nearby_lifters_.empty() ? nullptr : &nearby_lifters_[k];
-      walls_.for_each_contact(
-          particles_.position[i], particles_.radius[i],
-          [&](const WallContact<D>& contact) {
-            int slot = 0;
-            while (slot < max_wall_contacts && slot_id[slot] != contact.wall_id) ++slot;
-            if (slot == max_wall_contacts) {
-              slot = 0;
-              while (slot < max_wall_contacts && slot_id[slot] >= 0) ++slot;
-              if (slot == max_wall_contacts) return;  // cannot happen: see max_wall_contacts
-              slot_id[slot] = contact.wall_id;
-            }
-            seen |= 1U << static_cast<unsigned>(slot);
-            WallWork found;
-            found.particle = i;
-            found.slot = static_cast<std::uint32_t>(k * max_wall_contacts) +
-                         static_cast<std::uint32_t>(slot);
-            found.contact = contact;
-            work_list.push_back(found);
-          },
-          nearby);
-      first_work[k - begin + 1] = static_cast<std::uint32_t>(work_list.size());
-      // Slots of walls the candidate no longer touches: their collisions have ended. (The law
-      // below works on the touched slots alone.)
-      unsigned held = 0;  // bit s: slot s holds a wall's history
-      for (int slot = 0; slot < max_wall_contacts; ++slot) {
-        held |= slot_id[slot] >= 0 ? 1U << static_cast<unsigned>(slot) : 0U;
-      }
-      for (unsigned ended_slots = held & ~seen; ended_slots != 0; ended_slots &= ended_slots - 1) {
-        const int slot = std::countr_zero(ended_slots);
-        block_ended[ended++] = {wall_contact_type(walls_.kind_of(slot_id[slot])),
-                                slot_history[slot].dissipated};
-        slot_history[slot] = ContactHistory<D>{};
-        slot_id[slot] = -1;
-      }
-    }
-    evaluate_wall_laws(work_list.data(), work_list.size());
-    for (std::size_t k = begin; k < end; ++k) {
-      // A candidate touching no wall adds nothing: its sums, begun at +0 and so never −0 (in
-      // round-to-nearest x + y is −0 only if both are), would stay the same bits.
-      if (first_work[k - begin] == first_work[k - begin + 1]) continue;
-      const std::uint32_t i = wall_candidates_[k];
-      Vec<D> force{};
-      Spin<D> moment{};
-      for (std::uint32_t w = first_work[k - begin]; w < first_work[k - begin + 1]; ++w) {
-        const WallWork& done = work_list[w];
-        force += done.force;
-        moment += done.moment;
-        dissipated += done.dissipated;
-        if (done.contact.kind != WallKind::plane) {
-          torque += axial_moment(done.contact.point, done.force);
-          work += dot(done.force, done.contact.wall_velocity) * dt;
-        }
-      }
-      // Added to the particle's sums after its pairs (the pair stage is done), before gravity.
-      particles_.force[i] += force;
-      particles_.torque[i] += moment;
-    }
-    wall_block_torque_[b] = torque;
-    wall_block_work_[b] = work;
-    wall_block_dissipated_[b] = dissipated;
-    wall_block_ended_[b] = ended;
-  };
-  if (candidates >= parallel_wall_threshold && pairs_split_among_threads()) {
-    // Each block on the thread that owns (split_pairs_among) the particle of its middle
-    // candidate: candidates are listed in particle order, so a thread works on its own
-    // particles, whose arrays are in its core's cache and whose force sums it alone writes. On
-    // the 2D SAG scene, handing blocks to whichever thread came free moved those arrays between
-    // the cores at every step and cost 8 % of the step on two threads (bench/results.md).
-    const auto ranges = static_cast<std::size_t>(split_threads_);
-#pragma omp parallel num_threads(split_threads_)
-    {
-      const auto team = static_cast<std::size_t>(omp_get_num_threads());
-      const auto thread = static_cast<std::size_t>(omp_get_thread_num());
-      for (std::size_t b = 0; b < blocks; ++b) {
-        const std::size_t middle = std::min(candidates - 1, b * wall_block + wall_block / 2);
-        const auto owner = static_cast<std::size_t>(std::upper_bound(split_particle_.begin() + 1,
-                                                                     split_particle_.end() - 1,
-                                                                     wall_candidates_[middle]) -
-                                                    (split_particle_.begin() + 1));
-        if (owner < ranges && owner % team == thread) wall_block_stage(b);
-      }
-    }
-  } else {
-    // Blocks differ in cost (a block of candidates along the lifters' faces costs more than one
-    // on the bare shell): handed out as threads come free.
+  // Blocks differ in cost (a block of candidates along the lifters' faces costs more than one
+  // on the bare shell): handed out as threads come free.
 #pragma omp parallel for schedule(dynamic) if (candidates >= parallel_wall_threshold)
-    for (std::size_t b = 0; b < blocks; ++b) wall_block_stage(b);
-  }
+  for (std::size_t b = 0; b < blocks; ++b) evaluate_wall_block(b);
+  finish_wall_stage();
+}
+
+template <int D>
+void World<D>::finish_wall_stage() {
+  const std::size_t blocks = wall_block_ended_.size();
   double torque = 0.0;
   for (std::size_t b = 0; b < blocks; ++b) {
     torque += wall_block_torque_[b];
@@ -921,6 +732,101 @@ void World<D>::evaluate_wall_contacts() {
   shell_torque_ = torque;
   account_.dissipated += last_step_dissipation_;
   record_ended(wall_ended_, wall_block_ended_, wall_block * max_wall_contacts);
+}
+
+template <int D>
+void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
+  const double dt = settings_.time_step;
+  const std::size_t candidates = wall_candidates_.size();
+  double torque = 0.0;
+  double work = 0.0;
+  double dissipated = 0.0;
+  std::uint32_t ended = 0;
+  EndedCollision* block_ended = &wall_ended_[b * wall_block * max_wall_contacts];
+  const std::size_t begin = b * wall_block;
+  const std::size_t end = std::min(candidates, begin + wall_block);
+  // The block's contacts, found candidate by candidate (each in its slot of wall-contact
+  // history), then their contact law worked out lane_count at a time, then each candidate's
+  // contacts added up in the order they were found. One list per thread, kept.
+  static thread_local std::vector<WallWork> work_list;
+  static thread_local std::vector<std::uint32_t> first_work;
+  work_list.clear();
+  first_work.assign(end - begin + 1, 0);
+  for (std::size_t k = begin; k < end; ++k) {
+    const std::uint32_t i = wall_candidates_[k];
+    std::int32_t* slot_id = &wall_slot_id_[k * max_wall_contacts];
+    ContactHistory<D>* slot_history = &wall_slot_history_[k * max_wall_contacts];
+    unsigned seen = 0;  // bit s: slot s touched now
+    const NearbyLifters* nearby = nearby_lifters_.empty() ? nullptr : &nearby_lifters_[k];
+    walls_.for_each_contact(
+        particles_.position[i], particles_.radius[i],
+        [&](const WallContact<D>& contact) {
+          int slot = 0;
+          while (slot < max_wall_contacts && slot_id[slot] != contact.wall_id) ++slot;
+          if (slot == max_wall_contacts) {
+            slot = 0;
+            while (slot < max_wall_contacts && slot_id[slot] >= 0) ++slot;
+            if (slot == max_wall_contacts) return;  // cannot happen: see max_wall_contacts
+            slot_id[slot] = contact.wall_id;
+          }
+          seen |= 1U << static_cast<unsigned>(slot);
+          WallWork found;
+          found.particle = i;
+          found.slot =
+              static_cast<std::uint32_t>(k * max_wall_contacts) + static_cast<std::uint32_t>(slot);
+          found.contact = contact;
+          work_list.push_back(found);
+        },
+        nearby);
+    first_work[k - begin + 1] = static_cast<std::uint32_t>(work_list.size());
+    // Slots of walls the candidate no longer touches: their collisions have ended. (The law
+    // below works on the touched slots alone.)
+    unsigned held = 0;  // bit s: slot s holds a wall's history
+    for (int slot = 0; slot < max_wall_contacts; ++slot) {
+      held |= slot_id[slot] >= 0 ? 1U << static_cast<unsigned>(slot) : 0U;
+    }
+    for (unsigned ended_slots = held & ~seen; ended_slots != 0; ended_slots &= ended_slots - 1) {
+      const int slot = std::countr_zero(ended_slots);
+      block_ended[ended++] = {wall_contact_type(walls_.kind_of(slot_id[slot])),
+                              slot_history[slot].dissipated};
+      slot_history[slot] = ContactHistory<D>{};
+      slot_id[slot] = -1;
+    }
+  }
+  evaluate_wall_laws(work_list.data(), work_list.size());
+  for (std::size_t k = begin; k < end; ++k) {
+    // A candidate touching no wall adds nothing: its sums, begun at +0 and so never −0 (in
+    // round-to-nearest x + y is −0 only if both are), would stay the same bits.
+    if (first_work[k - begin] == first_work[k - begin + 1]) {
+      if (kept != nullptr) kept[k - begin].touches = false;
+      continue;
+    }
+    const std::uint32_t i = wall_candidates_[k];
+    Vec<D> force{};
+    Spin<D> moment{};
+    for (std::uint32_t w = first_work[k - begin]; w < first_work[k - begin + 1]; ++w) {
+      const WallWork& done = work_list[w];
+      force += done.force;
+      moment += done.moment;
+      dissipated += done.dissipated;
+      if (done.contact.kind != WallKind::plane) {
+        torque += axial_moment(done.contact.point, done.force);
+        work += dot(done.force, done.contact.wall_velocity) * dt;
+      }
+    }
+    // Added to the particle's sums after its pairs (they are all done), before gravity; or
+    // kept to be added then.
+    if (kept != nullptr) {
+      kept[k - begin] = {force, moment, true};
+      continue;
+    }
+    particles_.force[i] += force;
+    particles_.torque[i] += moment;
+  }
+  wall_block_torque_[b] = torque;
+  wall_block_work_[b] = work;
+  wall_block_dissipated_[b] = dissipated;
+  wall_block_ended_[b] = ended;
 }
 
 template <int D>
@@ -1016,18 +922,273 @@ bool World<D>::accumulate_forces_and_integrate() {
   // u(n+1) = u(n) + u̇(n+½) Δt; the same for rotation. Still in the same pass, the next step's
   // estimates u̇(n+1) ≈ u̇(n+½) + ½ ü(n) Δt (as estimate_current_velocities makes them), and
   // whether the particle has moved half a skin since the neighbour list was made.
-  const bool periodic = neighbours_.period() > 0.0;
-  return for_each_particle_run([&](std::size_t begin, std::size_t end) {
-    if (periodic) return integrate_particles<true>(begin, end);
+  return for_each_particle_run(
+      [&](std::size_t begin, std::size_t end) { return integrate_run(begin, end); });
+}
+
+template <int D>
+bool World<D>::integrate_run(std::size_t begin, std::size_t end) {
+  if (neighbours_.period() > 0.0) return integrate_particles<true>(begin, end);
 #if defined(__x86_64__)
-    // In 2D only: a sphere's three components do not pair up in registers, and the 3D loop
-    // ran slower so (bench/results.md).
-    if constexpr (D == 2) {
-      if (avx2_lanes_) return integrate_particles_avx2(begin, end);
-    }
+  // In 2D only: a sphere's three components do not pair up in registers, and the 3D loop
+  // ran slower so (bench/results.md).
+  if constexpr (D == 2) {
+    if (avx2_lanes_) return integrate_particles_avx2(begin, end);
+  }
 #endif
-    return integrate_particles<false>(begin, end);
-  });
+  return integrate_particles<false>(begin, end);
+}
+
+template <int D>
+bool World<D>::stages_on_one_thread() {
+  if (particles_.size() != neighbours_.built_count()) return false;
+  if (omp_get_max_threads() == 1) return true;
+  return !pairs_split_among_threads() && wall_candidates_.size() < parallel_wall_threshold &&
+         particles_.size() < parallel_threshold;
+}
+
+template <int D>
+bool World<D>::run_stages_in_one_pass() {
+  const std::size_t count = particles_.size();
+  std::memset(static_cast<void*>(particles_.force.data()), 0, count * sizeof(Vec<D>));
+  std::memset(static_cast<void*>(particles_.torque.data()), 0, count * sizeof(Spin<D>));
+  const auto& first = neighbours_.first();
+  const std::size_t pairs = first.size();
+  const std::size_t blocks = pair_block_ended_.size();
+  ParticleRun run(*this, 0, count, 0, wall_candidates_.size());
+  for (std::size_t b = 0; b < blocks; ++b) {
+    evaluate_pair_block(b);
+    const std::size_t next = (b + 1) * pair_block;
+    run.advance_below(next < pairs ? std::size_t{first[next]} : count);
+  }
+  run.advance_below(count);
+  finish_pair_stage();
+  finish_wall_stage();
+  return run.moved;
+}
+
+template <int D>
+World<D>::ParticleRun::ParticleRun(World& world, std::size_t particle_begin,
+                                   std::size_t particle_end, std::size_t candidate_begin,
+                                   std::size_t candidate_end)
+    : world_(world),
+      advanced_(particle_begin),
+      particle_end_(particle_end),
+      candidate_begin_(candidate_begin),
+      candidate_end_(candidate_end),
+      next_wall_block_(candidate_begin / wall_block),
+      wall_block_end_(candidate_begin < candidate_end ? block_count(candidate_end, wall_block)
+                                                      : candidate_begin / wall_block) {}
+
+template <int D>
+void World<D>::ParticleRun::advance_below(std::size_t complete) {
+  // Wall candidates are listed in particle order: a wall block can be done once every one of
+  // its candidates has all its pair forces.
+  const auto& candidates = world_.wall_candidates_;
+  while (next_wall_block_ < wall_block_end_) {
+    const std::size_t block_begin = next_wall_block_ * wall_block;
+    const std::size_t block_end = std::min(candidates.size(), block_begin + wall_block);
+    const std::size_t begin = std::max(block_begin, candidate_begin_);
+    const std::size_t end = std::min(block_end, candidate_end_);
+    if (candidates[end - 1] >= complete) break;
+    if (begin == block_begin && end == block_end) {
+      world_.evaluate_wall_block(next_wall_block_);
+    } else {
+      // A block shared with another run, done apart, its candidates' sums kept.
+      const auto shared = static_cast<std::size_t>(
+          std::lower_bound(world_.shared_wall_blocks_.begin(), world_.shared_wall_blocks_.end(),
+                           next_wall_block_) -
+          world_.shared_wall_blocks_.begin());
+      world_.do_shared_wall_block(shared);
+      const WallSum* kept = &world_.shared_wall_sums_[shared * wall_block];
+      for (std::size_t k = begin; k < end; ++k) {
+        const WallSum& sum = kept[k - block_begin];
+        if (!sum.touches) continue;
+        world_.particles_.force[candidates[k]] += sum.force;
+        world_.particles_.torque[candidates[k]] += sum.moment;
+      }
+    }
+    ++next_wall_block_;
+  }
+  std::size_t ready = std::min(complete, particle_end_);
+  if (next_wall_block_ < wall_block_end_) {
+    ready = std::min<std::size_t>(
+        ready, candidates[std::max(next_wall_block_ * wall_block, candidate_begin_)]);
+  }
+  if (ready > advanced_) {
+    moved = world_.integrate_run(advanced_, ready) || moved;
+    advanced_ = ready;
+  }
+}
+
+template <int D>
+void World<D>::do_shared_wall_block(std::size_t k) {
+  // The flag holds 2 s + 1 once step s has done the block, 2 s while a thread does it.
+  std::atomic<std::uint64_t>& flag = shared_wall_done_[k];
+  const std::uint64_t taken = 2 * shared_wall_stamp_;
+  const std::uint64_t done = taken + 1;
+  std::uint64_t seen = flag.load(std::memory_order_acquire);
+  if (seen < taken && flag.compare_exchange_strong(seen, taken, std::memory_order_acquire)) {
+    evaluate_wall_block(shared_wall_blocks_[k], &shared_wall_sums_[k * wall_block]);
+    flag.store(done, std::memory_order_release);
+    flag.notify_all();
+    return;
+  }
+  // Another thread has taken it: wait until it is done.
+  while (seen != done) {
+    flag.wait(seen, std::memory_order_acquire);
+    seen = flag.load(std::memory_order_acquire);
+  }
+}
+
+template <int D>
+bool World<D>::run_stages_split_among_threads() {
+  // Thread t owns a run of particles and the pairs whose first particle is one of them
+  // (split_pairs_among), and goes through the three stages on them interleaved, as
+  // run_stages_in_one_pass does on one thread; the sums of every particle are made in the same
+  // order. A pair whose second particle belongs to a later thread (a cross pair: 1.5 % of the 3D
+  // 20 k scene's on two threads) is evaluated first, before a barrier; then each thread zeroes
+  // its particles, adds the cross pairs' forces to their second particles (they come before any
+  // of its own pairs in pair order), and goes down its own pairs, adding each one's force to both
+  // particles, or, for a cross pair, the stored force to the first. A block of pairs that lies in
+  // one thread's run and holds no cross pair is gone through as on one thread
+  // (evaluate_pair_block); in the others (mixed_blocks_: at most a few per thread) each pair's
+  // dissipation and end are kept apart and summed afterwards, in the same order. (Keeping every
+  // pair's apart cost a third more instructions per pair: callgrind, the 2D SAG scene.) A wall
+  // block is done by the thread that owns its candidates' particles, whose arrays are in its
+  // core's cache and whose sums it alone writes (on the 2D SAG scene, handing wall blocks to
+  // whichever thread came free moved those arrays between the cores at every step and cost 8 %
+  // of the step: bench/results.md). A block whose candidates belong to two threads is done by
+  // the later one first thing (do_shared_wall_block), each candidate's sums kept until its own
+  // thread adds them; the earlier thread needs it only at the end of its run. (Done before the
+  // barrier instead, it held the other thread waiting: 2D SAG, two threads, 2 % slower.)
+  const auto& first = neighbours_.first();
+  const auto& second = neighbours_.second();
+  const auto& r = particles_.radius;
+  auto& force = particles_.force;
+  auto& torque = particles_.torque;
+  const std::size_t pairs = first.size();
+  const std::size_t candidates = wall_candidates_.size();
+  const auto ranges = static_cast<std::size_t>(split_threads_);
+  split_candidate_.resize(ranges + 1);
+  shared_wall_blocks_.clear();
+  for (std::size_t t = 0; t <= ranges; ++t) {
+    split_candidate_[t] = static_cast<std::uint32_t>(
+        std::lower_bound(wall_candidates_.begin(), wall_candidates_.end(), split_particle_[t]) -
+        wall_candidates_.begin());
+    const std::size_t k = split_candidate_[t];
+    if (t > 0 && t < ranges && k % wall_block != 0 && k < candidates &&
+        (shared_wall_blocks_.empty() || shared_wall_blocks_.back() != k / wall_block)) {
+      shared_wall_blocks_.push_back(static_cast<std::uint32_t>(k / wall_block));
+    }
+  }
+  shared_wall_sums_.resize(shared_wall_blocks_.size() * wall_block);
+  shared_wall_done_.reserve(shared_wall_blocks_.size());
+  ++shared_wall_stamp_;
+  pair_status_.resize(pairs);
+  pair_energy_.resize(pairs);
+  const std::size_t crossing = cross_pairs_.size();
+  bool moved = false;
+#pragma omp parallel num_threads(split_threads_) reduction(|| : moved)
+  {
+#pragma omp for schedule(static)
+    for (std::size_t c = 0; c < crossing; ++c) {
+      const std::uint32_t q = cross_pairs_[c];
+      const PairOutcome outcome = evaluate_pair(q, cross_force_[c]);
+      pair_status_[q] = outcome.status;
+      pair_energy_[q] = outcome.energy;
+    }
+    // The implicit barrier of the loop above: every cross pair's force is known.
+    const auto team = static_cast<std::size_t>(omp_get_num_threads());
+    for (auto t = static_cast<std::size_t>(omp_get_thread_num()); t < ranges; t += team) {
+      const std::uint32_t own_begin = split_particle_[t];
+      const std::uint32_t own_end = split_particle_[t + 1];
+      // A wall block shared with earlier runs that holds this run's first candidates: done now,
+      // as a rule before the earlier run's thread needs it at the end of its run (a block is
+      // done by whichever thread comes to it first, so that no thread waits for itself).
+      const std::size_t k = split_candidate_[t];
+      if (k % wall_block != 0 && k < candidates) {
+        const auto first_shared =
+            static_cast<std::size_t>(std::lower_bound(shared_wall_blocks_.begin(),
+                                                      shared_wall_blocks_.end(), k / wall_block) -
+                                     shared_wall_blocks_.begin());
+        do_shared_wall_block(first_shared);
+      }
+      for (std::uint32_t i = own_begin; i < own_end; ++i) {
+        force[i] = Vec<D>{};
+        torque[i] = Spin<D>{};
+      }
+      for (std::size_t c = 0; c < crossing; ++c) {
+        const std::uint32_t q = cross_pairs_[c];
+        const std::uint32_t j = second[q];
+        if (j >= own_begin && j < own_end && pair_status_[q] == PairStatus::touching) {
+          force[j] += cross_force_[c].force;
+          torque[j] += r[j] * cross_force_[c].moment;
+        }
+      }
+      ParticleRun run(*this, own_begin, own_end, split_candidate_[t], split_candidate_[t + 1]);
+      std::size_t c = static_cast<std::size_t>(
+          std::lower_bound(cross_pairs_.begin(), cross_pairs_.end(), split_pair_[t]) -
+          cross_pairs_.begin());
+      const std::size_t own_pairs_end = split_pair_[t + 1];
+      std::size_t q = split_pair_[t];
+      while (q < own_pairs_end) {
+        const std::size_t b = q / pair_block;
+        if (!block_mixed_[b]) {
+          evaluate_pair_block(b);  // which starts at q and ends in this run
+          q = std::min(pairs, (b + 1) * pair_block);
+        } else {
+          const std::size_t end = std::min(own_pairs_end, (b + 1) * pair_block);
+          for (; q < end; ++q) {
+            const std::uint32_t i = first[q];
+            const std::uint32_t j = second[q];
+            if (j >= own_end) {
+              if (pair_status_[q] == PairStatus::touching) {
+                force[i] -= cross_force_[c].force;
+                torque[i] += r[i] * cross_force_[c].moment;
+              }
+              ++c;
+              continue;
+            }
+            PairForce f;
+            const PairOutcome outcome = evaluate_pair(q, f);
+            pair_status_[q] = outcome.status;
+            pair_energy_[q] = outcome.energy;
+            if (outcome.status == PairStatus::touching) {
+              force[i] -= f.force;
+              torque[i] += r[i] * f.moment;
+              force[j] += f.force;
+              torque[j] += r[j] * f.moment;
+            }
+          }
+        }
+        run.advance_below(q < own_pairs_end ? std::size_t{first[q]} : std::size_t{own_end});
+      }
+      run.advance_below(own_end);
+      moved = run.moved || moved;
+    }
+#pragma omp barrier
+    const std::size_t mixed = mixed_blocks_.size();
+#pragma omp for schedule(static)
+    for (std::size_t k = 0; k < mixed; ++k) {
+      const std::size_t b = mixed_blocks_[k];
+      double dissipated = 0.0;
+      std::uint32_t ended = 0;
+      const std::size_t end = std::min(pairs, (b + 1) * pair_block);
+      for (std::size_t q = b * pair_block; q < end; ++q) {
+        if (pair_status_[q] == PairStatus::touching) {
+          dissipated += pair_energy_[q];
+        } else if (pair_status_[q] == PairStatus::ended) {
+          pair_ended_[b * pair_block + ended++] = {ContactType::ball_ball, pair_energy_[q]};
+        }
+      }
+      pair_block_dissipated_[b] = dissipated;
+      pair_block_ended_[b] = ended;
+    }
+  }
+  finish_pair_stage();
+  finish_wall_stage();
+  return moved;
 }
 
 #if defined(__x86_64__)

@@ -3,7 +3,9 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
+#include <memory>
 #include <tuple>
 #include <vector>
 
@@ -55,6 +57,36 @@ struct EnergyAccount {
 /// instructions: the order decays slowly, most particles taking hundreds of steps to cross a
 /// cell.
 inline constexpr int cell_order_interval = 10;
+
+/// Flags that threads set and wait on within a step (World's shared wall blocks), each holding
+/// a number that grows from step to step. Nothing is in flight between steps, so a copy starts
+/// with none, and they are made again (zero, below any step's number) when needed.
+class StepFlags {
+ public:
+  StepFlags() = default;
+  StepFlags(const StepFlags& /*other*/) {}
+  StepFlags& operator=(const StepFlags& other) {
+    if (this != &other) {
+      flags_.reset();
+      size_ = 0;
+    }
+    return *this;
+  }
+  StepFlags(StepFlags&&) = default;
+  StepFlags& operator=(StepFlags&&) = default;
+  ~StepFlags() = default;
+  /// At least `count` flags, all zero if they had to be made.
+  void reserve(std::size_t count) {
+    if (count <= size_) return;
+    flags_ = std::make_unique<std::atomic<std::uint64_t>[]>(count);
+    size_ = count;
+  }
+  std::atomic<std::uint64_t>& operator[](std::size_t k) { return flags_[k]; }
+
+ private:
+  std::unique_ptr<std::atomic<std::uint64_t>[]> flags_;
+  std::size_t size_ = 0;
+};
 
 template <int D>
 class World {
@@ -162,7 +194,42 @@ class World {
   /// In debug builds, stops if the estimates the last step made differ from those of the
   /// particles now (they were changed through a reference kept across steps).
   void check_estimates_made() const;
+  /// Whether the pair, wall and integration stages all run on one thread this step; then
+  /// run_stages_in_one_pass does them.
+  bool stages_on_one_thread();
+  /// The three stages interleaved, on one thread: a particle is advanced as soon as its forces
+  /// are summed. Returns what accumulate_forces_and_integrate returns.
+  bool run_stages_in_one_pass();
+  /// The same on several threads, each on its own run of particles (split_pairs_among).
+  bool run_stages_split_among_threads();
+  /// Shared wall block k (shared_wall_blocks_[k]) done in this step, its candidates' sums kept
+  /// (shared_wall_sums_): by this thread if no other has taken it, else waited for.
+  void do_shared_wall_block(std::size_t k);
+  /// One thread's run of particles [particle_begin, particle_end), with the wall candidates
+  /// [candidate_begin, candidate_end) that are theirs, taken through the wall and integration
+  /// stages as the pair stage completes their sums.
+  class ParticleRun {
+   public:
+    ParticleRun(World& world, std::size_t particle_begin, std::size_t particle_end,
+                std::size_t candidate_begin, std::size_t candidate_end);
+    /// Every particle of the run below `complete` has all its pair forces: does the wall blocks
+    /// whose candidates all do, and advances the particles that have all their forces.
+    void advance_below(std::size_t complete);
+    bool moved = false;  ///< whether an advanced particle has moved half a skin
+
+   private:
+    World& world_;
+    std::size_t advanced_;
+    std::size_t particle_end_;
+    std::size_t candidate_begin_, candidate_end_;
+    std::size_t next_wall_block_, wall_block_end_;
+  };
   void evaluate_pair_contacts();
+  /// Block b of the pairs on this thread: its listed pairs found and evaluated, their forces
+  /// added to both particles in pair order, the block's dissipation and ended collisions kept.
+  void evaluate_pair_block(std::size_t b);
+  /// The pair stage's last part: the step's dissipation so far and the ended collisions.
+  void finish_pair_stage();
   /// The pairs of block `block` listed in `listed` (those that overlap or did until now), in
   /// pair order, lane_count at a time (core/lanes.hpp): their contacts are worked out side by
   /// side, then each pair's outcome applied in pair order as one at a time would. Adds the
@@ -219,9 +286,23 @@ class World {
   void refresh_nearby_lifters();
   bool lifters_moved_too_far() const;
   void evaluate_wall_contacts();
+  /// Block b of the wall candidates on this thread: their contacts found and evaluated, each
+  /// candidate's wall forces added to its sums, the block's torque, work, dissipation and ended
+  /// collisions kept.
+  /// A candidate's wall sums, kept to be added to its particle later (kept != nullptr).
+  struct WallSum {
+    Vec<D> force{};
+    Spin<D> moment{};
+    bool touches = false;  ///< whether it touches a wall (else it adds nothing)
+  };
+  void evaluate_wall_block(std::size_t b, WallSum* kept = nullptr);
+  /// The wall stage's last part: the block sums added up in block order.
+  void finish_wall_stage();
   /// Also makes the next step's velocity estimates, and returns whether some particle has moved
   /// more than half the skin since the neighbour list was made.
   bool accumulate_forces_and_integrate();
+  /// Particles [begin, end) advanced by the loop for this world (integrate_particles).
+  bool integrate_run(std::size_t begin, std::size_t end);
   /// Its loop over particles [begin, end), for a periodic slab or not. In 2D the one without a
   /// period is compiled twice, for processors with AVX2 (two discs in a register, where the
   /// other works on one) and for any x86-64, the same bits either way.
@@ -281,6 +362,10 @@ class World {
     PairStatus status;
     double energy;
   };
+  /// Pair q alone: its contact this step. Writes the force on the second particle and the
+  /// moment both receive (scaled by their radii) to `out` if the pair touches, and returns what
+  /// happened.
+  PairOutcome evaluate_pair(std::size_t q, PairForce& out);
   // Several threads (evaluate_pair_contacts): per thread, the first of its particles and of
   // its pairs (and one past the last, at the end), for split_threads_ threads and the list of
   // rebuild split_rebuild_; the cross pairs, in pair order, and their forces this step; and per
@@ -296,6 +381,15 @@ class World {
   // (then its pairs' status and energy are kept apart), and those blocks in order.
   std::vector<std::uint8_t> block_mixed_;
   std::vector<std::uint32_t> mixed_blocks_;
+  // Per thread (run_stages_split_among_threads), the first of its wall candidates; the wall
+  // blocks that hold candidates of two threads, and their candidates' sums (wall_block each).
+  std::vector<std::uint32_t> split_candidate_;
+  std::vector<std::uint32_t> shared_wall_blocks_;
+  std::vector<WallSum> shared_wall_sums_;
+  // Per shared wall block, how far the steps have done it (do_shared_wall_block); the number of
+  // steps that have split the stages among threads, this one included.
+  StepFlags shared_wall_done_;
+  std::uint64_t shared_wall_stamp_ = 0;
   // Work is split in blocks of a fixed size; each block keeps its own sums and ended
   // collisions, added up in block order, so results do not depend on the number of threads.
   std::vector<EndedCollision> pair_ended_;  // block b's at [b × pair_block, ...)
