@@ -251,14 +251,17 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
   // Carry the history of pairs kept from the old list, found among the old pairs of the lower
   // of the two old indices. A pair whose particles were renumbered in the other order has its
   // bodies A and B swapped: its tangential spring, the force on B, changes sign (the other
-  // quantities of the history are the same for both bodies).
+  // quantities of the history are the same for both bodies). On several threads from as many
+  // particles as the search: a smaller world's step runs on one thread, and a parallel region
+  // here at every rebuild kept a second core spinning through it (OpenMP's threads wait
+  // actively for a while after each region).
   reserve_with_slack(next_history_, next_first_.size());
   reserve_with_slack(next_touching_, next_first_.size());
   next_history_.assign(next_first_.size(), ContactHistory<D>{});
   next_touching_.assign(next_first_.size(), TouchState::apart);
   const std::size_t old_count = first_begin_.empty() ? 0 : first_begin_.size() - 1;
   const std::size_t pairs = next_first_.size();
-#pragma omp parallel for schedule(static) if (pairs >= parallel_search_threshold)
+#pragma omp parallel for schedule(static) if (count >= parallel_search_threshold)
   for (std::size_t p = 0; p < pairs; ++p) {
     std::uint32_t a = into_cell_order ? previous_index_[next_first_[p]] : next_first_[p];
     std::uint32_t b = into_cell_order ? previous_index_[next_second_[p]] : next_second_[p];
