@@ -1222,10 +1222,29 @@ bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
   // Keeps positions in [0, period) along the axis of a periodic slab.
   const double period = neighbours_.period();
   unsigned moved = 0;
+  // In 3D worlds large enough for the pair kernel to prefetch, the arrays the pair stage has not
+  // brought into the cache (it reads a particle's velocities only where it touches another, and
+  // never the inverse masses or the rebuild's positions) are fetched a few particles ahead: the
+  // 1e6-ball slab of the scaling series, one thread, 1.36–1.38e7 → 1.41–1.42e7 particle-steps/s.
+  // (A 2D world that large would take the plain loop too, at the cost of its second build.)
+  constexpr std::size_t prefetch_distance = 12;
+  const bool prefetch = D == 3 && prefetch_pairs_;
+  const std::size_t last = p.size() - 1;
 #if !defined(__clang__)  // GCC's; `omp simd` left this loop unvectorised
 #pragma GCC ivdep
 #endif
   for (std::size_t i = begin; i < end; ++i) {
+    if (prefetch) {
+      const std::size_t ahead = std::min(i + prefetch_distance, last);
+      __builtin_prefetch(&reference[ahead]);
+      __builtin_prefetch(&inverse_mass[ahead]);
+      __builtin_prefetch(&inverse_inertia[ahead]);
+      __builtin_prefetch(&position[ahead], 1);
+      __builtin_prefetch(&velocity[ahead], 1);
+      __builtin_prefetch(&spin[ahead], 1);
+      __builtin_prefetch(&velocity_now[ahead], 1);
+      __builtin_prefetch(&spin_now[ahead], 1);
+    }
     force[i] += mass[i] * gravity;
     velocity[i] += (inverse_mass[i] * dt) * force[i];
     position[i] += dt * velocity[i];
