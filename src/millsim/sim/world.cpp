@@ -520,8 +520,7 @@ void World<D>::evaluate_pair_contacts() {
   // Each particle sums its pairs in pair order (pairs where it is second come first, as their
   // first particle has the lower index): the order in which one thread going down the list
   // meets them. The pairs add their forces to the particles as they go.
-  std::fill(particles_.force.begin(), particles_.force.end(), Vec<D>{});
-  std::fill(particles_.torque.begin(), particles_.torque.end(), Spin<D>{});
+  zero_sums(0, particles_.size());
   const std::size_t blocks = pair_block_ended_.size();
   for (std::size_t b = 0; b < blocks; ++b) evaluate_pair_block(b);
   finish_pair_stage();
@@ -950,8 +949,7 @@ bool World<D>::stages_on_one_thread() {
 template <int D>
 bool World<D>::run_stages_in_one_pass() {
   const std::size_t count = particles_.size();
-  std::memset(static_cast<void*>(particles_.force.data()), 0, count * sizeof(Vec<D>));
-  std::memset(static_cast<void*>(particles_.torque.data()), 0, count * sizeof(Spin<D>));
+  zero_sums(0, count);
   const auto& first = neighbours_.first();
   const std::size_t pairs = first.size();
   const std::size_t blocks = pair_block_ended_.size();
@@ -995,10 +993,7 @@ void World<D>::ParticleRun::advance_below(std::size_t complete) {
       world_.evaluate_wall_block(next_wall_block_);
     } else {
       // A block shared with another run, done apart, its candidates' sums kept.
-      const auto shared = static_cast<std::size_t>(
-          std::lower_bound(world_.shared_wall_blocks_.begin(), world_.shared_wall_blocks_.end(),
-                           next_wall_block_) -
-          world_.shared_wall_blocks_.begin());
+      const std::size_t shared = world_.shared_wall_block_index(next_wall_block_);
       world_.do_shared_wall_block(shared);
       const WallSum* kept = &world_.shared_wall_sums_[shared * wall_block];
       for (std::size_t k = begin; k < end; ++k) {
@@ -1019,6 +1014,22 @@ void World<D>::ParticleRun::advance_below(std::size_t complete) {
     moved = world_.integrate_run(advanced_, ready) || moved;
     advanced_ = ready;
   }
+}
+
+template <int D>
+void World<D>::zero_sums(std::size_t begin, std::size_t end) {
+  // All bits zero is +0 in every component.
+  std::memset(static_cast<void*>(particles_.force.data() + begin), 0,
+              (end - begin) * sizeof(Vec<D>));
+  std::memset(static_cast<void*>(particles_.torque.data() + begin), 0,
+              (end - begin) * sizeof(Spin<D>));
+}
+
+template <int D>
+std::size_t World<D>::shared_wall_block_index(std::size_t block) const {
+  return static_cast<std::size_t>(
+      std::lower_bound(shared_wall_blocks_.begin(), shared_wall_blocks_.end(), block) -
+      shared_wall_blocks_.begin());
 }
 
 template <int D>
@@ -1108,16 +1119,9 @@ bool World<D>::run_stages_split_among_threads() {
       // done by whichever thread comes to it first, so that no thread waits for itself).
       const std::size_t k = split_candidate_[t];
       if (k % wall_block != 0 && k < candidates) {
-        const auto first_shared =
-            static_cast<std::size_t>(std::lower_bound(shared_wall_blocks_.begin(),
-                                                      shared_wall_blocks_.end(), k / wall_block) -
-                                     shared_wall_blocks_.begin());
-        do_shared_wall_block(first_shared);
+        do_shared_wall_block(shared_wall_block_index(k / wall_block));
       }
-      for (std::uint32_t i = own_begin; i < own_end; ++i) {
-        force[i] = Vec<D>{};
-        torque[i] = Spin<D>{};
-      }
+      zero_sums(own_begin, own_end);
       for (std::size_t c = 0; c < crossing; ++c) {
         const std::uint32_t q = cross_pairs_[c];
         const std::uint32_t j = second[q];

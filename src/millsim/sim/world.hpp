@@ -205,6 +205,10 @@ class World {
   /// Shared wall block k (shared_wall_blocks_[k]) done in this step, its candidates' sums kept
   /// (shared_wall_sums_): by this thread if no other has taken it, else waited for.
   void do_shared_wall_block(std::size_t k);
+  /// Where wall block `block` is in shared_wall_blocks_ (it must be there).
+  std::size_t shared_wall_block_index(std::size_t block) const;
+  /// Zeroes the force and torque sums of particles [begin, end).
+  void zero_sums(std::size_t begin, std::size_t end);
   /// One thread's run of particles [particle_begin, particle_end), with the wall candidates
   /// [candidate_begin, candidate_end) that are theirs, taken through the wall and integration
   /// stages as the pair stage completes their sums.
