@@ -1,7 +1,7 @@
 // Deterministic by construction (STYLE.md rule 5): the same scene stepped on one thread, on
 // two and on three gives bitwise-identical particles, energy accounts and collision spectra. The
-// stages of World::step() go parallel only above 2048 items (particles, wall candidates;
-// 5120 listed pairs; `parallel_threshold` in sim/world.cpp), so the scenes are big enough for every
+// stages of World::step() go parallel only above 2048 items (particles, wall candidates,
+// listed pairs; `parallel_threshold` in sim/world.cpp), so the scenes are big enough for every
 // parallel path to run, and the test checks that they are. The particles are renumbered in
 // cell order at every neighbour-list rebuild (the mill job does it less often), during the
 // compared steps too, and come out in the same order on one thread and on two.
@@ -28,7 +28,7 @@ namespace {
 /// The item count above which a stage of World::step() runs in parallel, and the listed pairs
 /// from which the pair stage does (sim/world.cpp).
 constexpr std::size_t parallel_threshold = 2048;
-constexpr std::size_t parallel_pair_threshold = 5120;
+constexpr std::size_t parallel_pair_threshold = 2048;
 
 /// Sets the OpenMP thread count for the life of the object, then puts the old one back.
 class ThreadCount {
@@ -323,6 +323,29 @@ TEST(Determinism, ShortWideMill3DIsTheSameOnOneTwoAndThreeThreads) {
 
 TEST(Determinism, PeriodicSlab3DIsTheSameOnOneTwoAndThreeThreads) {
   expect_3d_scene_deterministic(true);
+}
+
+TEST(Determinism, SmallSlabSplitInSmallBlocksIsTheSameOnOneTwoAndThreeThreads) {
+  // The slab of the scaling benchmark (bench/scaling-mill.toml: 996 balls of 1 cm, 4.1 cm of a
+  // 0.3 m mill): a few thousand listed pairs and a few hundred wall candidates, so that its
+  // blocks are small (World::pair_block_size) and several of them are shared by two threads'
+  // runs or hold pairs across them at every step. Placed apart, drawn in towards the axis and
+  // set moving at up to 1 m/s: a loose charge, with tens of contacts at a time.
+  const MillPlan plan =
+      plan_mill(load_mill_config(std::string(MILLSIM_SOURCE_DIR) + "/bench/scaling-mill.toml",
+                                 {"output.snapshot_interval=0"}));
+  const World<3> scene = moving_scene<3>(plan, 0.15, 0.75, 1.0, 200);
+  const Outcome<3> one = step_on(scene, 600, 1);
+  expect_identical(one, step_on(scene, 600, 2));
+  expect_identical(one, step_on(scene, 600, 3));
+  const World<3>& world = one.world;
+  EXPECT_GT(listed_pairs(world), parallel_pair_threshold);
+  EXPECT_LT(world.pair_block_size(), 1024u);
+  EXPECT_LT(world.wall_block_size(), 256u);
+  EXPECT_GT(world.neighbour_rebuilds(), scene.neighbour_rebuilds());
+  EXPECT_GT(world.touching_contacts(), 20u);
+  EXPECT_GT(one.spectrum.total_count(ContactType::ball_ball), 100);
+  EXPECT_GT(one.spectrum.total_count(ContactType::ball_shell), 10);
 }
 
 TEST(Determinism, StagesSplitThreeWaysButRunByOneThreadGiveTheSameBits) {

@@ -165,6 +165,35 @@ TEST(NeighbourList, PeriodicAxisMatchesBruteForceByTheNearestImage) {
   check_equal_radii<3>({0.5, 1.0, 1.5}, box_side<3>);
 }
 
+TEST(NeighbourList, ThinSlabIsOrderedAlongItsWiderAxisAndMatchesBruteForce) {
+  // 600 spheres in a slab 28 wide (x, y) and 7 thick along the last axis, periodic along it
+  // and not: the cells are put in order with the wider of the two outer axes varying slowest,
+  // so that a run of particles in that order is a layer across y, not across the thin axis.
+  for (const double period : {0.0, 7.0}) {
+    Cloud<3> cloud = random_cloud<3>(600, 28.0, 6);
+    for (Vec3& x : cloud.position) x[2] *= 0.25;
+    NeighbourList<3> list(skin);
+    list.set_period(period);
+    list.rebuild(cloud.position, cloud.radius, true);
+    Cloud<3> renumbered;
+    for (const std::uint32_t before : list.previous_index()) {
+      renumbered.position.push_back(cloud.position[before]);
+      renumbered.radius.push_back(cloud.radius[before]);
+    }
+    const PairList expected = brute_force_pairs_periodic(renumbered, skin, period);
+    ASSERT_GT(expected.size(), 600u);
+    EXPECT_EQ(listed_pairs(list), expected);
+    // In the new order y does not fall by more than a cell (the cells are at least 2 × 0.5 +
+    // skin = 1.3 wide) from one particle to the next, while z does, many times.
+    std::size_t z_falls = 0;
+    for (std::size_t k = 1; k < renumbered.position.size(); ++k) {
+      EXPECT_GT(renumbered.position[k][1], renumbered.position[k - 1][1] - 5.0) << k;
+      z_falls += renumbered.position[k][2] < renumbered.position[k - 1][2] - 1.0 ? 1 : 0;
+    }
+    EXPECT_GT(z_falls, 10u);
+  }
+}
+
 TEST(NeighbourList, WideSpreadCloudStillMatchesBruteForce) {
   // Two clumps 10⁴ apart: the grid grows its cells rather than holding 10⁸ of them, and the
   // pairs must not change.

@@ -30,21 +30,36 @@ ContactType wall_contact_type(WallKind kind) {
   return ContactType::ball_plane;
 }
 
-/// Blocks of a fixed size: the unit of parallel work and of partial sums.
-constexpr std::size_t pair_block = 1024;
-constexpr std::size_t wall_block = 256;
+/// Blocks of pairs and of wall candidates are the unit of parallel work and of partial sums.
+/// Their sizes are chosen at each rebuild from the list alone (block_size_for), never from
+/// the number of threads, so that results do not depend on it: at least 16 blocks of pairs and
+/// 4 of candidates where the list allows, each of 256–1024 pairs or 64–256 candidates. Large
+/// blocks cost less per pair (the 2D SAG scene, 941 candidates, was 0.7 % slower on two threads
+/// in 8 blocks of 128 than in 4 of 256); in a small world, where one block was a third of the
+/// list, the blocks that two threads' runs share (done one pair at a time, or by one thread for
+/// both) held up the step (bench/results.md).
+constexpr std::size_t min_pair_block = 256;
+constexpr std::size_t max_pair_block = 1024;
+constexpr std::size_t min_wall_block = 64;
+constexpr std::size_t max_wall_block = 256;
 /// Below this many items a stage runs on one thread (a parallel region costs microseconds).
 constexpr std::size_t parallel_threshold = 2048;
 /// The pair stage, and with it the particle stages, split among threads from this many listed
 /// pairs, where two threads and one break even: below it the threads' barriers cost more than
-/// the split saves (the 3D scaling slab on two threads against one: 996 balls and 2 500 pairs
-/// 1.5 times slower, 2 000 balls and 5 000 pairs as fast, 4 000 balls and 10 000 pairs 1.4
-/// times faster; bench/results.md).
-constexpr std::size_t parallel_pair_threshold = 5120;
-/// The same for the wall stage, whose candidates cost tens of pairs each: from two blocks on
-/// (the 2D SAG scene has about a thousand candidates; on one thread they held the other one
-/// waiting for 3 % of the step).
-constexpr std::size_t parallel_wall_threshold = 2 * wall_block;
+/// the split saves (the 3D scaling slab of 996 balls and 2 500 pairs on two threads against
+/// one: 1.1 times faster; bench/results.md).
+constexpr std::size_t parallel_pair_threshold = 2048;
+/// The same for the old three-stage path's wall stage, whose candidates cost tens of pairs
+/// each: from 512 on (the 2D SAG scene has about a thousand candidates; on one thread they held
+/// the other one waiting for 3 % of the step).
+constexpr std::size_t parallel_wall_threshold = 2 * max_wall_block;
+
+/// The block size for a list of `items`: count / blocks rounded up to a power of two, within
+/// [smallest, largest].
+std::size_t block_size_for(std::size_t items, std::size_t blocks, std::size_t smallest,
+                           std::size_t largest) {
+  return std::clamp(std::bit_ceil(std::max<std::size_t>(1, items / blocks)), smallest, largest);
+}
 /// When the particle arrays that the pair kernel reads and writes hold more than this many
 /// bytes, several times a core's second-level cache, the kernel prefetches the particles and
 /// history of the pairs two lanes ahead: the second particle of a pair is met out of order and
@@ -169,8 +184,9 @@ void World<D>::refresh_neighbours(bool moved) {
   // The arrays of prefetch_pairs.
   constexpr std::size_t kernel_bytes = 3 * sizeof(Vec<D>) + 3 * sizeof(Spin<D>) + sizeof(double);
   prefetch_pairs_ = count * kernel_bytes > prefetch_threshold_bytes;
-  pair_block_ended_.resize(block_count(pairs, pair_block));
-  pair_block_dissipated_.resize(block_count(pairs, pair_block));
+  pair_block_ = block_size_for(pairs, 16, min_pair_block, max_pair_block);
+  pair_block_ended_.resize(block_count(pairs, pair_block_));
+  pair_block_dissipated_.resize(block_count(pairs, pair_block_));
 
   // Wall candidates: a particle further than a skin from every wall cannot reach one before
   // it has moved half a skin, which triggers the next rebuild. Each candidate has
@@ -213,10 +229,11 @@ void World<D>::refresh_neighbours(bool moved) {
   wall_slot_history_.swap(next_wall_slot_history_);
   const std::size_t candidates = wall_candidates_.size();
   wall_ended_.resize(candidates * max_wall_contacts);
-  wall_block_ended_.resize(block_count(candidates, wall_block));
-  wall_block_dissipated_.resize(block_count(candidates, wall_block));
-  wall_block_torque_.resize(block_count(candidates, wall_block));
-  wall_block_work_.resize(block_count(candidates, wall_block));
+  wall_block_ = block_size_for(candidates, 4, min_wall_block, max_wall_block);
+  wall_block_ended_.resize(block_count(candidates, wall_block_));
+  wall_block_dissipated_.resize(block_count(candidates, wall_block_));
+  wall_block_torque_.resize(block_count(candidates, wall_block_));
+  wall_block_work_.resize(block_count(candidates, wall_block_));
   refresh_nearby_lifters();
 }
 
@@ -458,12 +475,12 @@ void World<D>::split_pairs_among(int threads) {
   cross_force_.resize(cross_pairs_.size());
   // Blocks of pairs that one thread cannot go through alone: those split between two runs and
   // those holding a cross pair.
-  block_mixed_.assign(block_count(pairs, pair_block), 0);
+  block_mixed_.assign(block_count(pairs, pair_block_), 0);
   for (std::size_t range = 1; range < ranges; ++range) {
     const std::size_t q = split_pair_[range];
-    if (q % pair_block != 0 && q < pairs) block_mixed_[q / pair_block] = 1;
+    if (q % pair_block_ != 0 && q < pairs) block_mixed_[q / pair_block_] = 1;
   }
-  for (const std::uint32_t q : cross_pairs_) block_mixed_[q / pair_block] = 1;
+  for (const std::uint32_t q : cross_pairs_) block_mixed_[q / pair_block_] = 1;
   mixed_blocks_.clear();
   for (std::size_t b = 0; b < block_mixed_.size(); ++b) {
     if (block_mixed_[b] != 0) mixed_blocks_.push_back(static_cast<std::uint32_t>(b));
@@ -530,7 +547,7 @@ template <int D>
 void World<D>::finish_pair_stage() {
   last_step_dissipation_ = 0.0;
   for (const double d : pair_block_dissipated_) last_step_dissipation_ += d;
-  record_ended(pair_ended_, pair_block_ended_, pair_block);
+  record_ended(pair_ended_, pair_block_ended_, pair_block_);
 }
 
 template <int D>
@@ -545,12 +562,12 @@ void World<D>::evaluate_pair_block(std::size_t b) {
   const std::size_t pairs = first.size();
   double dissipated = 0.0;
   std::uint32_t ended = 0;
-  const std::size_t begin = b * pair_block;
-  const std::size_t end = std::min(pairs, begin + pair_block);
+  const std::size_t begin = b * pair_block_;
+  const std::size_t end = std::min(pairs, begin + pair_block_);
   // Pairs that overlap now or did until now, in pair order: the rest need nothing. Listed
   // without a branch (a third of the 2D SAG scene's listed pairs touch, scattered among the
   // others, which the processor could only mispredict).
-  std::array<std::uint32_t, pair_block> listed;
+  std::array<std::uint32_t, max_pair_block> listed;
   std::size_t count = 0;
   for (std::size_t q = begin; q < end; ++q) {
     const Vec<D> offset = neighbours_.separation(x[first[q]], x[second[q]]);
@@ -619,7 +636,7 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
   auto& history = neighbours_.history();
   auto& touching = neighbours_.touching();
   const double dt = settings_.time_step;
-  const std::size_t begin = block * pair_block;
+  const std::size_t begin = block * pair_block_;
 
   for (std::size_t k = 0; k < count; k += lanes) {
     if (prefetch_pairs_)
@@ -730,7 +747,7 @@ void World<D>::finish_wall_stage() {
   }
   shell_torque_ = torque;
   account_.dissipated += last_step_dissipation_;
-  record_ended(wall_ended_, wall_block_ended_, wall_block * max_wall_contacts);
+  record_ended(wall_ended_, wall_block_ended_, wall_block_ * max_wall_contacts);
 }
 
 template <int D>
@@ -741,9 +758,9 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
   double work = 0.0;
   double dissipated = 0.0;
   std::uint32_t ended = 0;
-  EndedCollision* block_ended = &wall_ended_[b * wall_block * max_wall_contacts];
-  const std::size_t begin = b * wall_block;
-  const std::size_t end = std::min(candidates, begin + wall_block);
+  EndedCollision* block_ended = &wall_ended_[b * wall_block_ * max_wall_contacts];
+  const std::size_t begin = b * wall_block_;
+  const std::size_t end = std::min(candidates, begin + wall_block_);
   // The block's contacts, found candidate by candidate (each in its slot of wall-contact
   // history), then their contact law worked out lane_count at a time, then each candidate's
   // contacts added up in the order they were found. One list per thread, kept.
@@ -956,7 +973,7 @@ bool World<D>::run_stages_in_one_pass() {
   ParticleRun run(*this, 0, count, 0, wall_candidates_.size());
   for (std::size_t b = 0; b < blocks; ++b) {
     evaluate_pair_block(b);
-    const std::size_t next = (b + 1) * pair_block;
+    const std::size_t next = (b + 1) * pair_block_;
     run.advance_below(next < pairs ? std::size_t{first[next]} : count);
   }
   run.advance_below(count);
@@ -974,9 +991,10 @@ World<D>::ParticleRun::ParticleRun(World& world, std::size_t particle_begin,
       particle_end_(particle_end),
       candidate_begin_(candidate_begin),
       candidate_end_(candidate_end),
-      next_wall_block_(candidate_begin / wall_block),
-      wall_block_end_(candidate_begin < candidate_end ? block_count(candidate_end, wall_block)
-                                                      : candidate_begin / wall_block) {}
+      next_wall_block_(candidate_begin / world.wall_block_),
+      wall_block_end_(candidate_begin < candidate_end
+                          ? block_count(candidate_end, world.wall_block_)
+                          : candidate_begin / world.wall_block_) {}
 
 template <int D>
 void World<D>::ParticleRun::advance_below(std::size_t complete) {
@@ -984,8 +1002,8 @@ void World<D>::ParticleRun::advance_below(std::size_t complete) {
   // its candidates has all its pair forces.
   const auto& candidates = world_.wall_candidates_;
   while (next_wall_block_ < wall_block_end_) {
-    const std::size_t block_begin = next_wall_block_ * wall_block;
-    const std::size_t block_end = std::min(candidates.size(), block_begin + wall_block);
+    const std::size_t block_begin = next_wall_block_ * world_.wall_block_;
+    const std::size_t block_end = std::min(candidates.size(), block_begin + world_.wall_block_);
     const std::size_t begin = std::max(block_begin, candidate_begin_);
     const std::size_t end = std::min(block_end, candidate_end_);
     if (candidates[end - 1] >= complete) break;
@@ -995,7 +1013,7 @@ void World<D>::ParticleRun::advance_below(std::size_t complete) {
       // A block shared with another run, done apart, its candidates' sums kept.
       const std::size_t shared = world_.shared_wall_block_index(next_wall_block_);
       world_.do_shared_wall_block(shared);
-      const WallSum* kept = &world_.shared_wall_sums_[shared * wall_block];
+      const WallSum* kept = &world_.shared_wall_sums_[shared * world_.wall_block_];
       for (std::size_t k = begin; k < end; ++k) {
         const WallSum& sum = kept[k - block_begin];
         if (!sum.touches) continue;
@@ -1008,7 +1026,7 @@ void World<D>::ParticleRun::advance_below(std::size_t complete) {
   std::size_t ready = std::min(complete, particle_end_);
   if (next_wall_block_ < wall_block_end_) {
     ready = std::min<std::size_t>(
-        ready, candidates[std::max(next_wall_block_ * wall_block, candidate_begin_)]);
+        ready, candidates[std::max(next_wall_block_ * world_.wall_block_, candidate_begin_)]);
   }
   if (ready > advanced_) {
     moved = world_.integrate_run(advanced_, ready) || moved;
@@ -1040,7 +1058,7 @@ void World<D>::do_shared_wall_block(std::size_t k) {
   const std::uint64_t done = taken + 1;
   std::uint64_t seen = flag.load(std::memory_order_acquire);
   if (seen < taken && flag.compare_exchange_strong(seen, taken, std::memory_order_acquire)) {
-    evaluate_wall_block(shared_wall_blocks_[k], &shared_wall_sums_[k * wall_block]);
+    evaluate_wall_block(shared_wall_blocks_[k], &shared_wall_sums_[k * wall_block_]);
     flag.store(done, std::memory_order_release);
     flag.notify_all();
     return;
@@ -1088,12 +1106,12 @@ bool World<D>::run_stages_split_among_threads() {
         std::lower_bound(wall_candidates_.begin(), wall_candidates_.end(), split_particle_[t]) -
         wall_candidates_.begin());
     const std::size_t k = split_candidate_[t];
-    if (t > 0 && t < ranges && k % wall_block != 0 && k < candidates &&
-        (shared_wall_blocks_.empty() || shared_wall_blocks_.back() != k / wall_block)) {
-      shared_wall_blocks_.push_back(static_cast<std::uint32_t>(k / wall_block));
+    if (t > 0 && t < ranges && k % wall_block_ != 0 && k < candidates &&
+        (shared_wall_blocks_.empty() || shared_wall_blocks_.back() != k / wall_block_)) {
+      shared_wall_blocks_.push_back(static_cast<std::uint32_t>(k / wall_block_));
     }
   }
-  shared_wall_sums_.resize(shared_wall_blocks_.size() * wall_block);
+  shared_wall_sums_.resize(shared_wall_blocks_.size() * wall_block_);
   shared_wall_done_.reserve(shared_wall_blocks_.size());
   ++shared_wall_stamp_;
   pair_status_.resize(pairs);
@@ -1118,8 +1136,8 @@ bool World<D>::run_stages_split_among_threads() {
       // as a rule before the earlier run's thread needs it at the end of its run (a block is
       // done by whichever thread comes to it first, so that no thread waits for itself).
       const std::size_t k = split_candidate_[t];
-      if (k % wall_block != 0 && k < candidates) {
-        do_shared_wall_block(shared_wall_block_index(k / wall_block));
+      if (k % wall_block_ != 0 && k < candidates) {
+        do_shared_wall_block(shared_wall_block_index(k / wall_block_));
       }
       zero_sums(own_begin, own_end);
       for (std::size_t c = 0; c < crossing; ++c) {
@@ -1137,12 +1155,12 @@ bool World<D>::run_stages_split_among_threads() {
       const std::size_t own_pairs_end = split_pair_[t + 1];
       std::size_t q = split_pair_[t];
       while (q < own_pairs_end) {
-        const std::size_t b = q / pair_block;
+        const std::size_t b = q / pair_block_;
         if (!block_mixed_[b]) {
           evaluate_pair_block(b);  // which starts at q and ends in this run
-          q = std::min(pairs, (b + 1) * pair_block);
+          q = std::min(pairs, (b + 1) * pair_block_);
         } else {
-          const std::size_t end = std::min(own_pairs_end, (b + 1) * pair_block);
+          const std::size_t end = std::min(own_pairs_end, (b + 1) * pair_block_);
           for (; q < end; ++q) {
             const std::uint32_t i = first[q];
             const std::uint32_t j = second[q];
@@ -1178,12 +1196,12 @@ bool World<D>::run_stages_split_among_threads() {
       const std::size_t b = mixed_blocks_[k];
       double dissipated = 0.0;
       std::uint32_t ended = 0;
-      const std::size_t end = std::min(pairs, (b + 1) * pair_block);
-      for (std::size_t q = b * pair_block; q < end; ++q) {
+      const std::size_t end = std::min(pairs, (b + 1) * pair_block_);
+      for (std::size_t q = b * pair_block_; q < end; ++q) {
         if (pair_status_[q] == PairStatus::touching) {
           dissipated += pair_energy_[q];
         } else if (pair_status_[q] == PairStatus::ended) {
-          pair_ended_[b * pair_block + ended++] = {ContactType::ball_ball, pair_energy_[q]};
+          pair_ended_[b * pair_block_ + ended++] = {ContactType::ball_ball, pair_energy_[q]};
         }
       }
       pair_block_dissipated_[b] = dissipated;

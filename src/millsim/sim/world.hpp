@@ -167,6 +167,11 @@ class World {
   std::size_t touching_contacts() const;
   /// Particles that may touch a wall before the next neighbour-list rebuild.
   std::size_t wall_candidate_count() const { return wall_candidates_.size(); }
+  /// Pairs per block of the pair stage, and wall candidates per block of the wall stage: the
+  /// unit of the threads' work and of partial sums, chosen at each neighbour-list rebuild from
+  /// the list alone, never from the number of threads.
+  std::size_t pair_block_size() const { return pair_block_; }
+  std::size_t wall_block_size() const { return wall_block_; }
 
   double kinetic_energy() const;        ///< translation and rotation, J
   double potential_energy() const;      ///< −Σ m g·x, J
@@ -386,7 +391,7 @@ class World {
   std::vector<std::uint8_t> block_mixed_;
   std::vector<std::uint32_t> mixed_blocks_;
   // Per thread (run_stages_split_among_threads), the first of its wall candidates; the wall
-  // blocks that hold candidates of two threads, and their candidates' sums (wall_block each).
+  // blocks that hold candidates of two threads, and their candidates' sums (wall_block_ each).
   std::vector<std::uint32_t> split_candidate_;
   std::vector<std::uint32_t> shared_wall_blocks_;
   std::vector<WallSum> shared_wall_sums_;
@@ -396,7 +401,9 @@ class World {
   std::uint64_t shared_wall_stamp_ = 0;
   // Work is split in blocks of a fixed size; each block keeps its own sums and ended
   // collisions, added up in block order, so results do not depend on the number of threads.
-  std::vector<EndedCollision> pair_ended_;  // block b's at [b × pair_block, ...)
+  std::size_t pair_block_ = 1024;  // pairs per block, and candidates per wall block, chosen
+  std::size_t wall_block_ = 256;   // at each rebuild (block_size_for in world.cpp)
+  std::vector<EndedCollision> pair_ended_;  // block b's at [b × pair_block_, ...)
   std::vector<std::uint32_t> pair_block_ended_;
   std::vector<double> pair_block_dissipated_;
 
@@ -422,7 +429,7 @@ class World {
   double lifter_travel_ = 0.0;
   int nearby_lifter_count_ = 0;
   long nearby_lifter_refreshes_ = 0;
-  std::vector<EndedCollision> wall_ended_;  // block b's at [b × wall_block × max, ...)
+  std::vector<EndedCollision> wall_ended_;  // block b's at [b × wall_block_ × max, ...)
   std::vector<std::uint32_t> wall_block_ended_;
   std::vector<double> wall_block_dissipated_, wall_block_torque_, wall_block_work_;
 
