@@ -10,9 +10,12 @@ namespace millsim {
 namespace {
 
 /// Particles searched by one thread at a time in a rebuild, and the fewest particles for which
-/// the search is worth running on several threads.
+/// the rebuild runs on several threads: by default, and where the caller's step runs on
+/// several threads anyway (set_parallel; below the default, in a world whose step runs on one
+/// thread, the rebuild's parallel regions would wake a second core only to keep it spinning).
 constexpr std::size_t search_chunk = 512;
 constexpr std::size_t parallel_search_threshold = 2048;
+constexpr std::size_t parallel_search_threshold_when_asked = 512;
 
 }  // namespace
 
@@ -45,6 +48,8 @@ template <int D>
 void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
                                const std::vector<double>& radius, bool into_cell_order) {
   const std::size_t count = position.size();
+  const bool parallel =
+      count >= (parallel_ ? parallel_search_threshold_when_asked : parallel_search_threshold);
   ++rebuild_count_;
   skin_ = next_skin_;
   next_first_.clear();
@@ -221,7 +226,7 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
     // below give the same pair list whatever the chunks and threads.
     const std::size_t chunks = (count + search_chunk - 1) / search_chunk;
     if (found_.size() < chunks) found_.resize(chunks);
-#pragma omp parallel for schedule(dynamic) if (count >= parallel_search_threshold)
+#pragma omp parallel for schedule(dynamic) if (parallel)
     for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
       std::vector<FoundPair>& found = found_[chunk];
       std::size_t n = 0;
@@ -251,7 +256,7 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       }
     }
     // pair_cursor_[i] is now the end of particle i's pairs, and the start of particle i + 1's.
-#pragma omp parallel for schedule(static) if (count >= parallel_search_threshold)
+#pragma omp parallel for schedule(static) if (parallel)
     for (std::size_t i = 0; i < count; ++i) {
       const std::uint32_t begin = i == 0 ? 0 : pair_cursor_[i - 1];
       std::sort(next_second_.begin() + begin, next_second_.begin() + pair_cursor_[i]);
@@ -270,7 +275,7 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
   next_touching_.assign(next_first_.size(), TouchState::apart);
   const std::size_t old_count = first_begin_.empty() ? 0 : first_begin_.size() - 1;
   const std::size_t pairs = next_first_.size();
-#pragma omp parallel for schedule(static) if (count >= parallel_search_threshold)
+#pragma omp parallel for schedule(static) if (parallel)
   for (std::size_t p = 0; p < pairs; ++p) {
     std::uint32_t a = into_cell_order ? previous_index_[next_first_[p]] : next_first_[p];
     std::uint32_t b = into_cell_order ? previous_index_[next_second_[p]] : next_second_[p];

@@ -75,6 +75,9 @@ class NeighbourList {
   /// must reorder every per-particle array of its own (position and radius too) the same way.
   void rebuild(const std::vector<Vec<D>>& position, const std::vector<double>& radius,
                bool into_cell_order = false);
+  /// Whether the caller's step runs on several threads, so that rebuilds may too from fewer
+  /// particles (512 instead of 2048). The same list either way.
+  void set_parallel(bool parallel) { parallel_ = parallel; }
   /// After a rebuild into cell order, for each new index the particle's index before it.
   const std::vector<std::uint32_t>& previous_index() const { return previous_index_; }
 
@@ -99,6 +102,7 @@ class NeighbourList {
   double next_skin_;
   double period_ = 0.0;
   long rebuild_count_ = 0;
+  bool parallel_ = false;  // set_parallel
   std::vector<std::uint32_t> first_, second_;
   std::vector<ContactHistory<D>> history_;
   std::vector<TouchState> touching_;

@@ -177,6 +177,9 @@ void World<D>::refresh_neighbours(bool moved) {
   neighbours_.set_skin(skin);
   const bool into_cell_order =
       cell_order_interval_ > 0 && neighbours_.rebuild_count() % cell_order_interval_ == 0;
+  // The last list's pairs say whether the step splits among threads (pairs_split_among_threads).
+  neighbours_.set_parallel(omp_get_max_threads() > 1 &&
+                           neighbours_.pair_count() >= parallel_pair_threshold);
   neighbours_.rebuild(particles_.position, particles_.radius, into_cell_order);
   if (into_cell_order) reorder_particles(neighbours_.previous_index());
   const std::size_t pairs = neighbours_.pair_count();
