@@ -54,11 +54,16 @@ constexpr std::size_t parallel_pair_threshold = 2048;
 /// the other one waiting for 3 % of the step).
 constexpr std::size_t parallel_wall_threshold = 2 * max_wall_block;
 
-/// The block size for a list of `items`: count / blocks rounded up to a power of two, within
+/// The block size for a list of `items`: items / blocks rounded up to a power of two, within
 /// [smallest, largest].
 std::size_t block_size_for(std::size_t items, std::size_t blocks, std::size_t smallest,
                            std::size_t largest) {
   return std::clamp(std::bit_ceil(std::max<std::size_t>(1, items / blocks)), smallest, largest);
+}
+
+/// Whether a list of `pairs` splits the step among `threads` threads.
+bool splits_among_threads(std::size_t pairs, int threads) {
+  return threads > 1 && pairs >= parallel_pair_threshold;
 }
 /// When the particle arrays that the pair kernel reads and writes hold more than this many
 /// bytes, several times a core's second-level cache, the kernel prefetches the particles and
@@ -177,9 +182,8 @@ void World<D>::refresh_neighbours(bool moved) {
   neighbours_.set_skin(skin);
   const bool into_cell_order =
       cell_order_interval_ > 0 && neighbours_.rebuild_count() % cell_order_interval_ == 0;
-  // The last list's pairs say whether the step splits among threads (pairs_split_among_threads).
-  neighbours_.set_parallel(omp_get_max_threads() > 1 &&
-                           neighbours_.pair_count() >= parallel_pair_threshold);
+  // The last list's pairs say whether the step splits among threads.
+  neighbours_.set_parallel(splits_among_threads(neighbours_.pair_count(), omp_get_max_threads()));
   neighbours_.rebuild(particles_.position, particles_.radius, into_cell_order);
   if (into_cell_order) reorder_particles(neighbours_.previous_index());
   const std::size_t pairs = neighbours_.pair_count();
@@ -333,7 +337,7 @@ template <int D>
 bool World<D>::pairs_split_among_threads() {
   const int threads = omp_get_max_threads();
   const std::size_t pairs = neighbours_.pair_count();
-  if (pairs < parallel_pair_threshold || threads == 1) return false;
+  if (!splits_among_threads(pairs, threads)) return false;
   if (threads != split_threads_ || neighbours_.rebuild_count() != split_rebuild_ ||
       split_pair_.back() != pairs) {
     split_pairs_among(threads);
