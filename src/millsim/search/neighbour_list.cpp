@@ -63,12 +63,25 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
     // cut-off needs: a small particle looks only at its neighbouring cells however large the
     // largest one is.
     const auto [smallest, largest] = std::minmax_element(radius.begin(), radius.end());
+    // The particles' bounds, on each thread over its share (minima and maxima are exact, so
+    // the bounds are the same however the particles are shared).
     Vec<D> low = position[0];
     Vec<D> high = position[0];
-    for (const Vec<D>& x : position) {
+#pragma omp parallel if (parallel)
+    {
+      Vec<D> own_low = position[0];
+      Vec<D> own_high = position[0];
+#pragma omp for schedule(static) nowait
+      for (std::size_t i = 0; i < count; ++i) {
+        for (int a = 0; a < D; ++a) {
+          own_low[a] = std::min(own_low[a], position[i][a]);
+          own_high[a] = std::max(own_high[a], position[i][a]);
+        }
+      }
+#pragma omp critical(neighbour_list_bounds)
       for (int a = 0; a < D; ++a) {
-        low[a] = std::min(low[a], x[a]);
-        high[a] = std::max(high[a], x[a]);
+        low[a] = std::min(low[a], own_low[a]);
+        high[a] = std::max(high[a], own_high[a]);
       }
     }
     const bool periodic = period_ > 0.0;
@@ -112,6 +125,7 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
     // of the pairs crossed between the runs of two threads (bench/results.md).
     const int outer = D == 3 && cells[1] > cells[D - 1] ? 1 : D - 1;
     const int middle = D == 3 ? 3 - outer : 0;  // unused in 2D
+#pragma omp parallel for schedule(static) if (parallel)
     for (std::size_t i = 0; i < count; ++i) {
       for (int a = 0; a < D; ++a) home[i][a] = cell_of(position[i][a], a);
       std::size_t index = static_cast<std::size_t>(home[i][outer]);
@@ -121,8 +135,8 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       }
       index = index * static_cast<std::size_t>(cells[0]) + static_cast<std::size_t>(home[i][0]);
       particle_cell_[i] = static_cast<std::uint32_t>(index);
-      ++cell_start_[index + 1];
     }
+    for (std::size_t i = 0; i < count; ++i) ++cell_start_[particle_cell_[i] + 1];
     for (std::size_t c = 0; c < total; ++c) cell_start_[c + 1] += cell_start_[c];
     // Each cell's members with their positions and radii copied alongside, so that the search
     // below reads them in sequence instead of gathering them from the particle arrays.
@@ -301,11 +315,11 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
     reference_position_ = position;
   }
 
-  // Where each particle's pairs as the first begin (a counting sort; pairs are already ordered
-  // by first).
+  // Where each particle's pairs as the first begin: the counting sort above left the end of
+  // particle i's pairs, the start of particle i + 1's, in pair_cursor_[i].
   first_begin_.assign(count + 1, 0);
-  for (std::size_t p = 0; p < first_.size(); ++p) ++first_begin_[first_[p] + 1];
-  for (std::size_t i = 0; i < count; ++i) first_begin_[i + 1] += first_begin_[i];
+  if (count > 0)
+    std::copy(pair_cursor_.begin(), pair_cursor_.begin() + count, first_begin_.begin() + 1);
 }
 
 template class NeighbourList<2>;

@@ -78,6 +78,7 @@ class NeighbourList {
   /// Whether the caller's step runs on several threads, so that rebuilds may too from fewer
   /// particles (512 instead of 2048). The same list either way.
   void set_parallel(bool parallel) { parallel_ = parallel; }
+  bool parallel() const { return parallel_; }
   /// After a rebuild into cell order, for each new index the particle's index before it.
   const std::vector<std::uint32_t>& previous_index() const { return previous_index_; }
 

@@ -44,6 +44,9 @@ constexpr std::size_t min_wall_block = 64;
 constexpr std::size_t max_wall_block = 256;
 /// Below this many items a stage runs on one thread (a parallel region costs microseconds).
 constexpr std::size_t parallel_threshold = 2048;
+/// The fewest wall candidates whose nearby lifters are found on several threads in a world
+/// whose step splits among them.
+constexpr std::size_t parallel_candidate_threshold_when_split = 256;
 /// The pair stage, and with it the particle stages, split among threads from this many listed
 /// pairs, where two threads and one break even: below it the threads' barriers cost more than
 /// the split saves (the 3D scaling slab of 996 balls and 2 500 pairs on two threads against
@@ -278,7 +281,12 @@ void World<D>::refresh_nearby_lifters() {
   nearby_lifters_.resize(candidates);
   // The reach is widened by a part in a million for the rounding of the distances.
   constexpr double rounding = 1.0 + 1e-6;
-#pragma omp parallel for schedule(static) if (candidates >= parallel_threshold)
+  // On several threads where the step splits among them (the other core is awake), from a few
+  // hundred candidates; otherwise from as many as the other parallel loops.
+  const bool parallel =
+      candidates >=
+      (neighbours_.parallel() ? parallel_candidate_threshold_when_split : parallel_threshold);
+#pragma omp parallel for schedule(static) if (parallel)
   for (std::size_t k = 0; k < candidates; ++k) {
     const std::size_t i = wall_candidates_[k];
     const Vec<D>& x = particles_.position[i];
