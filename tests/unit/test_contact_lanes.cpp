@@ -188,5 +188,43 @@ TEST(ContactLanes, HelpersWorkLaneByLane) {
   }
 }
 
+TEST(ContactLanes, TwoDimensionalVectorsMoveBetweenLanesAndRows) {
+  // lanes_of: lane l of component d is f(l)[d]; pairs_of gives each lane's vector back.
+  const auto vector_of = [](std::size_t l) {
+    const auto a = static_cast<double>(l);
+    return Vec2{{1.0 + a, -10.0 * a}};
+  };
+  const Vec<2, Lanes> lanes_2d = lanes_of(vector_of);
+  const std::array<Pair2, lanes> back = pairs_of(lanes_2d);
+  for (std::size_t l = 0; l < lanes; ++l) {
+    for (int d = 0; d < 2; ++d) {
+      EXPECT_EQ(lanes_2d[d][l], vector_of(l)[d]) << "lane " << l << ", component " << d;
+      EXPECT_EQ(back[l][d], vector_of(l)[d]) << "lane " << l << ", component " << d;
+    }
+  }
+  // Differences and sums of two components at once: the bits of a Vec2's.
+  Vec2 sum{{0.1, -0.3}};
+  Vec2 expected = sum;
+  add_to(sum, pair_of(Vec2{{0.2, 0.7}}));
+  expected += Vec2{{0.2, 0.7}};
+  EXPECT_EQ(sum[0], expected[0]);
+  EXPECT_EQ(sum[1], expected[1]);
+  subtract_from(sum, pair_of(Vec2{{1.0 / 3.0, 2.0 / 3.0}}));
+  expected -= Vec2{{1.0 / 3.0, 2.0 / 3.0}};
+  EXPECT_EQ(sum[0], expected[0]);
+  EXPECT_EQ(sum[1], expected[1]);
+  // rows_of: row l holds lane l of each of the four.
+  std::array<Lanes, 4> columns{};
+  for (std::size_t c = 0; c < 4; ++c) {
+    for (std::size_t l = 0; l < lanes; ++l) columns[c][l] = static_cast<double>(10 * c + l);
+  }
+  const std::array<Lanes, lanes> rows = rows_of(columns[0], columns[1], columns[2], columns[3]);
+  for (std::size_t l = 0; l < lanes; ++l) {
+    for (std::size_t c = 0; c < 4; ++c) {
+      EXPECT_EQ(rows[l][c], columns[c][l]) << "row " << l << ", column " << c;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace millsim

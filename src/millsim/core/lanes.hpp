@@ -6,6 +6,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <utility>
 
 #include "millsim/core/vec.hpp"
@@ -96,6 +98,63 @@ template <class T>
     for (int l = 0; l < lane_count; ++l) r[l] = x;
     return r;
   }
+}
+
+/// A 2D vector's two components in one register (SSE2), for the pair kernel's gathers and sums
+/// in 2D: the same operations on each component as on a Vec<2>.
+using Pair2 = double __attribute__((vector_size(sizeof(double) * 2)));
+/// Lane indices for __builtin_shuffle of Lanes.
+using LaneIndex = std::int64_t __attribute__((vector_size(sizeof(std::int64_t) * lane_count)));
+
+[[gnu::always_inline]] inline Pair2 pair_of(const Vec<2>& a) {
+  Pair2 r;
+  std::memcpy(&r, a.c.data(), sizeof r);
+  return r;
+}
+[[gnu::always_inline]] inline Pair2 pair_of(Pair2 a) {
+  return a;
+}
+/// a += b and a −= b, both components at once.
+[[gnu::always_inline]] inline void add_to(Vec<2>& a, Pair2 b) {
+  const Pair2 sum = pair_of(a) + b;
+  std::memcpy(a.c.data(), &sum, sizeof sum);
+}
+[[gnu::always_inline]] inline void subtract_from(Vec<2>& a, Pair2 b) {
+  const Pair2 difference = pair_of(a) - b;
+  std::memcpy(a.c.data(), &difference, sizeof difference);
+}
+
+/// Lanes of 2D vectors: f(l) (a Vec<2> or a Pair2) in lane l.
+template <class F>
+[[gnu::always_inline]] inline Vec<2, Lanes> lanes_of(F&& f) {
+  static_assert(lane_count == 4);
+  const Pair2 p0 = pair_of(f(0)), p1 = pair_of(f(1)), p2 = pair_of(f(2)), p3 = pair_of(f(3));
+  const Lanes a = {p0[0], p0[1], p2[0], p2[1]};
+  const Lanes b = {p1[0], p1[1], p3[0], p3[1]};
+  return {{__builtin_shuffle(a, b, LaneIndex{0, 4, 2, 6}),
+           __builtin_shuffle(a, b, LaneIndex{1, 5, 3, 7})}};
+}
+
+/// The 2D vector of each lane: the inverse of lanes_of.
+[[gnu::always_inline]] inline std::array<Pair2, lane_count> pairs_of(const Vec<2, Lanes>& v) {
+  const Lanes low = __builtin_shuffle(v[0], v[1], LaneIndex{0, 4, 2, 6});   // x0 y0 x2 y2
+  const Lanes high = __builtin_shuffle(v[0], v[1], LaneIndex{1, 5, 3, 7});  // x1 y1 x3 y3
+  return {Pair2{low[0], low[1]}, Pair2{high[0], high[1]}, Pair2{low[2], low[3]},
+          Pair2{high[2], high[3]}};
+}
+
+/// Four lanes of four values each, a b c d, as four rows, one per lane: row l holds
+/// a[l] b[l] c[l] d[l].
+[[gnu::always_inline]] inline std::array<Lanes, lane_count> rows_of(Lanes a, Lanes b, Lanes c,
+                                                                    Lanes d) {
+  const Lanes t0 = __builtin_shuffle(a, b, LaneIndex{0, 4, 2, 6});
+  const Lanes t1 = __builtin_shuffle(a, b, LaneIndex{1, 5, 3, 7});
+  const Lanes t2 = __builtin_shuffle(c, d, LaneIndex{0, 4, 2, 6});
+  const Lanes t3 = __builtin_shuffle(c, d, LaneIndex{1, 5, 3, 7});
+  return {__builtin_shuffle(t0, t2, LaneIndex{0, 1, 4, 5}),
+          __builtin_shuffle(t1, t3, LaneIndex{0, 1, 4, 5}),
+          __builtin_shuffle(t0, t2, LaneIndex{2, 3, 6, 7}),
+          __builtin_shuffle(t1, t3, LaneIndex{2, 3, 6, 7})};
 }
 
 }  // namespace millsim

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -582,16 +583,27 @@ void World<D>::evaluate_pair_block(std::size_t b) {
   // Pairs that overlap now or did until now, in pair order: the rest need nothing. Listed
   // without a branch (a third of the 2D SAG scene's listed pairs touch, scattered among the
   // others, which the processor could only mispredict).
-  std::array<std::uint32_t, max_pair_block> listed;
+  // The kernel takes them lane_count at a time: the last group is filled up with copies of the
+  // last pair (evaluate_listed_pairs_in_lanes).
+  std::array<std::uint32_t, max_pair_block + lane_count> listed;
   std::size_t count = 0;
   for (std::size_t q = begin; q < end; ++q) {
-    const Vec<D> offset = neighbours_.separation(x[first[q]], x[second[q]]);
+    double distance_squared = 0.0;
+    if constexpr (D == 2) {
+      // Both components at once (never periodic in 2D): the same bits as norm_squared.
+      const Pair2 offset = pair_of(x[second[q]]) - pair_of(x[first[q]]);
+      const Pair2 squares = offset * offset;
+      distance_squared = squares[0] + squares[1];
+    } else {
+      distance_squared = norm_squared(neighbours_.separation(x[first[q]], x[second[q]]));
+    }
     const double reach = r[first[q]] + r[second[q]];
-    const unsigned overlaps = norm_squared(offset) < reach * reach ? 1U : 0U;
+    const unsigned overlaps = distance_squared < reach * reach ? 1U : 0U;
     const unsigned touched = touching[q] == TouchState::touching ? 1U : 0U;
     listed[count] = static_cast<std::uint32_t>(q);
     count += overlaps | touched;
   }
+  for (std::size_t l = count; count > 0 && l % lane_count != 0; ++l) listed[l] = listed[count - 1];
   evaluate_listed_pairs(b, listed.data(), count, dissipated, ended);
   pair_block_dissipated_[b] = dissipated;
   pair_block_ended_[b] = ended;
@@ -656,24 +668,36 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
   for (std::size_t k = 0; k < count; k += lanes) {
     if (prefetch_pairs_)
       prefetch_pairs(listed, std::min(count, k + 2 * lanes), std::min(count, k + 3 * lanes));
-    // The pairs of the lanes; where fewer remain, the last one fills the rest.
+    // The pairs of the lanes; where fewer remain, the last one fills the rest (the caller has
+    // listed it again up to a whole group).
     std::array<std::uint32_t, lanes> q{}, i{}, j{};
     const std::size_t filled = std::min(lanes, count - k);
     for (std::size_t l = 0; l < lanes; ++l) {
-      q[l] = listed[k + std::min(l, filled - 1)];
+      q[l] = listed[k + l];
       i[l] = neighbours_.first()[q[l]];
       j[l] = neighbours_.second()[q[l]];
     }
-    std::array<Vec<D>, lanes> offset;
-    for (std::size_t l = 0; l < lanes; ++l)
-      offset[l] = neighbours_.separation(p.position[i[l]], p.position[j[l]]);
     Vec<D, T> separation;
     Vec<D, T> velocity, step_velocity;
-    for (int d = 0; d < D; ++d) {
-      separation[d] = gather_lanes([&](std::size_t l) { return offset[l][d]; });
-      velocity[d] = gather_lanes([&](std::size_t l) { return v[j[l]][d] - v[i[l]][d]; });
-      step_velocity[d] =
-          gather_lanes([&](std::size_t l) { return p.velocity[j[l]][d] - p.velocity[i[l]][d]; });
+    if constexpr (D == 2) {
+      // Each particle's two components in one register, the pair's difference taken in it (a 2D
+      // world is never periodic: World::axial_period), and four such differences turned into
+      // lanes: the same subtractions as one by one.
+      separation = lanes_of(
+          [&](std::size_t l) { return pair_of(p.position[j[l]]) - pair_of(p.position[i[l]]); });
+      velocity = lanes_of([&](std::size_t l) { return pair_of(v[j[l]]) - pair_of(v[i[l]]); });
+      step_velocity = lanes_of(
+          [&](std::size_t l) { return pair_of(p.velocity[j[l]]) - pair_of(p.velocity[i[l]]); });
+    } else {
+      std::array<Vec<D>, lanes> offset;
+      for (std::size_t l = 0; l < lanes; ++l)
+        offset[l] = neighbours_.separation(p.position[i[l]], p.position[j[l]]);
+      for (int d = 0; d < D; ++d) {
+        separation[d] = gather_lanes([&](std::size_t l) { return offset[l][d]; });
+        velocity[d] = gather_lanes([&](std::size_t l) { return v[j[l]][d] - v[i[l]][d]; });
+        step_velocity[d] =
+            gather_lanes([&](std::size_t l) { return p.velocity[j[l]][d] - p.velocity[i[l]][d]; });
+      }
     }
     const T reach = gather_lanes([&](std::size_t l) { return r[i[l]] + r[j[l]]; });
     const T distance_squared = norm_squared(separation);
@@ -708,34 +732,64 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
 
     // Each pair's outcome, in pair order: a pair that no longer overlaps has ended (it is
     // listed, so it touched until now); the others add their forces.
-    for (std::size_t l = 0; l < filled; ++l) {
-      const std::uint32_t pair = q[l];
-      if (overlaps[l] == 0) {
-        pair_ended_[begin + ended++] = {ContactType::ball_ball, history[pair].dissipated};
-        history[pair] = ContactHistory<D>{};
-        touching[pair] = TouchState::apart;
-        continue;
-      }
-      touching[pair] = TouchState::touching;
-      ContactHistory<D>& h = history[pair];
-      h.normal_spring_origin = held.normal_spring_origin[l];
-      for (int d = 0; d < D; ++d) h.tangential_spring[d] = held.tangential_spring[d][l];
-      h.dissipated = held.dissipated[l];
-      h.overlap = in.overlap[l];
-      Vec<D> f;
-      for (int d = 0; d < D; ++d) f[d] = out.force[d][l];
-      particles_.force[i[l]] -= f;
-      particles_.force[j[l]] += f;
-      if constexpr (D == 2) {
+    if constexpr (D == 2) {
+      // The histories of the four lanes at once: those of ended pairs zeroed, the rest the
+      // law's (a lane that repeats the last pair writes what that one does). Written after
+      // the ended pairs' energies are read below.
+      const T zero{};
+      const auto kept = [&](T value) { return select(overlaps, value, zero); };
+      const std::array<Pair2, lanes> force_of = pairs_of(out.force);
+      for (std::size_t l = 0; l < filled; ++l) {
+        const std::uint32_t pair = q[l];
+        if (overlaps[l] == 0) {
+          pair_ended_[begin + ended++] = {ContactType::ball_ball, history[pair].dissipated};
+          touching[pair] = TouchState::apart;
+          continue;
+        }
+        touching[pair] = TouchState::touching;
+        subtract_from(particles_.force[i[l]], force_of[l]);
+        add_to(particles_.force[j[l]], force_of[l]);
         particles_.torque[i[l]] += r[i[l]] * moment[l];
         particles_.torque[j[l]] += r[j[l]] * moment[l];
-      } else {
+        dissipated += out.dissipated[l];
+      }
+      // The first four fields of a 2D history, in the order of a row.
+      static_assert(offsetof(ContactHistory<2>, normal_spring_origin) == 0 &&
+                    offsetof(ContactHistory<2>, tangential_spring) == sizeof(double) &&
+                    offsetof(ContactHistory<2>, dissipated) == 3 * sizeof(double));
+      const std::array<Lanes, lanes> rows =
+          rows_of(kept(held.normal_spring_origin), kept(held.tangential_spring[0]),
+                  kept(held.tangential_spring[1]), kept(held.dissipated));
+      for (std::size_t l = 0; l < lanes; ++l) {
+        std::memcpy(static_cast<void*>(&history[q[l]]), &rows[l], sizeof(Lanes));
+      }
+      const T overlap = kept(in.overlap);
+      for (std::size_t l = 0; l < lanes; ++l) history[q[l]].overlap = overlap[l];
+    } else {
+      for (std::size_t l = 0; l < filled; ++l) {
+        const std::uint32_t pair = q[l];
+        if (overlaps[l] == 0) {
+          pair_ended_[begin + ended++] = {ContactType::ball_ball, history[pair].dissipated};
+          history[pair] = ContactHistory<D>{};
+          touching[pair] = TouchState::apart;
+          continue;
+        }
+        touching[pair] = TouchState::touching;
+        ContactHistory<D>& h = history[pair];
+        h.normal_spring_origin = held.normal_spring_origin[l];
+        for (int d = 0; d < D; ++d) h.tangential_spring[d] = held.tangential_spring[d][l];
+        h.dissipated = held.dissipated[l];
+        h.overlap = in.overlap[l];
+        Vec<D> f;
+        for (int d = 0; d < D; ++d) f[d] = out.force[d][l];
+        particles_.force[i[l]] -= f;
+        particles_.force[j[l]] += f;
         Vec3 turn;
         for (int d = 0; d < 3; ++d) turn[d] = moment[d][l];
         particles_.torque[i[l]] += r[i[l]] * turn;
         particles_.torque[j[l]] += r[j[l]] * turn;
+        dissipated += out.dissipated[l];
       }
-      dissipated += out.dissipated[l];
     }
   }
 }
