@@ -143,18 +143,4 @@ template <class F>
           Pair2{high[2], high[3]}};
 }
 
-/// Four lanes of four values each, a b c d, as four rows, one per lane: row l holds
-/// a[l] b[l] c[l] d[l].
-[[gnu::always_inline]] inline std::array<Lanes, lane_count> rows_of(Lanes a, Lanes b, Lanes c,
-                                                                    Lanes d) {
-  const Lanes t0 = __builtin_shuffle(a, b, LaneIndex{0, 4, 2, 6});
-  const Lanes t1 = __builtin_shuffle(a, b, LaneIndex{1, 5, 3, 7});
-  const Lanes t2 = __builtin_shuffle(c, d, LaneIndex{0, 4, 2, 6});
-  const Lanes t3 = __builtin_shuffle(c, d, LaneIndex{1, 5, 3, 7});
-  return {__builtin_shuffle(t0, t2, LaneIndex{0, 1, 4, 5}),
-          __builtin_shuffle(t1, t3, LaneIndex{0, 1, 4, 5}),
-          __builtin_shuffle(t0, t2, LaneIndex{2, 3, 6, 7}),
-          __builtin_shuffle(t1, t3, LaneIndex{2, 3, 6, 7})};
-}
-
 }  // namespace millsim

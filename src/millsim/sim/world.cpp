@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
-#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -733,9 +732,9 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
     // Each pair's outcome, in pair order: a pair that no longer overlaps has ended (it is
     // listed, so it touched until now); the others add their forces.
     if constexpr (D == 2) {
-      // The histories of the four lanes at once: those of ended pairs zeroed, the rest the
-      // law's (a lane that repeats the last pair writes what that one does). Written after
-      // the ended pairs' energies are read below.
+      // The histories of the four lanes, written without a branch after the ended pairs'
+      // energies are read: those of ended pairs zeroed, the rest the law's (a lane that repeats
+      // the last pair writes what that one does).
       const T zero{};
       const auto kept = [&](T value) { return select(overlaps, value, zero); };
       const std::array<Pair2, lanes> force_of = pairs_of(out.force);
@@ -753,18 +752,16 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
         particles_.torque[j[l]] += r[j[l]] * moment[l];
         dissipated += out.dissipated[l];
       }
-      // The first four fields of a 2D history, in the order of a row.
-      static_assert(offsetof(ContactHistory<2>, normal_spring_origin) == 0 &&
-                    offsetof(ContactHistory<2>, tangential_spring) == sizeof(double) &&
-                    offsetof(ContactHistory<2>, dissipated) == 3 * sizeof(double));
-      const std::array<Lanes, lanes> rows =
-          rows_of(kept(held.normal_spring_origin), kept(held.tangential_spring[0]),
-                  kept(held.tangential_spring[1]), kept(held.dissipated));
+      const T origin = kept(held.normal_spring_origin), spring_x = kept(held.tangential_spring[0]),
+              spring_y = kept(held.tangential_spring[1]), energy = kept(held.dissipated),
+              overlap = kept(in.overlap);
       for (std::size_t l = 0; l < lanes; ++l) {
-        std::memcpy(static_cast<void*>(&history[q[l]]), &rows[l], sizeof(Lanes));
+        ContactHistory<D>& h = history[q[l]];
+        h.normal_spring_origin = origin[l];
+        h.tangential_spring = {{spring_x[l], spring_y[l]}};
+        h.dissipated = energy[l];
+        h.overlap = overlap[l];
       }
-      const T overlap = kept(in.overlap);
-      for (std::size_t l = 0; l < lanes; ++l) history[q[l]].overlap = overlap[l];
     } else {
       for (std::size_t l = 0; l < filled; ++l) {
         const std::uint32_t pair = q[l];
