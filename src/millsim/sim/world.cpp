@@ -566,25 +566,16 @@ void World<D>::finish_pair_stage() {
 }
 
 template <int D>
-void World<D>::evaluate_pair_block(std::size_t b) {
-  // Block b, all of it, on one thread: each pair's force added in pair order, the block's
-  // dissipation summed and its ended collisions listed in pair order.
+std::size_t World<D>::list_pairs_for_law(std::size_t begin, std::size_t end, std::size_t below,
+                                         std::uint32_t* listed) const {
   const auto& first = neighbours_.first();
   const auto& second = neighbours_.second();
   const auto& touching = neighbours_.touching();
   const auto& x = particles_.position;
   const auto& r = particles_.radius;
-  const std::size_t pairs = first.size();
-  double dissipated = 0.0;
-  std::uint32_t ended = 0;
-  const std::size_t begin = b * pair_block_;
-  const std::size_t end = std::min(pairs, begin + pair_block_);
   // Pairs that overlap now or did until now, in pair order: the rest need nothing. Listed
   // without a branch (a third of the 2D SAG scene's listed pairs touch, scattered among the
   // others, which the processor could only mispredict).
-  // The kernel takes them lane_count at a time: the last group is filled up with copies of the
-  // last pair (evaluate_listed_pairs_in_lanes).
-  std::array<std::uint32_t, max_pair_block + lane_count> listed;
   std::size_t count = 0;
   for (std::size_t q = begin; q < end; ++q) {
     double distance_squared = 0.0;
@@ -599,10 +590,27 @@ void World<D>::evaluate_pair_block(std::size_t b) {
     const double reach = r[first[q]] + r[second[q]];
     const unsigned overlaps = distance_squared < reach * reach ? 1U : 0U;
     const unsigned touched = touching[q] == TouchState::touching ? 1U : 0U;
+    const unsigned own = second[q] < below ? 1U : 0U;
     listed[count] = static_cast<std::uint32_t>(q);
-    count += overlaps | touched;
+    count += (overlaps | touched) & own;
   }
+  // The kernel takes them lane_count at a time: the last group is filled up with copies of the
+  // last pair (evaluate_listed_pairs_in_lanes).
   for (std::size_t l = count; count > 0 && l % lane_count != 0; ++l) listed[l] = listed[count - 1];
+  return count;
+}
+
+template <int D>
+void World<D>::evaluate_pair_block(std::size_t b) {
+  // Block b, all of it, on one thread: each pair's force added in pair order, the block's
+  // dissipation summed and its ended collisions listed in pair order.
+  const std::size_t pairs = neighbours_.first().size();
+  double dissipated = 0.0;
+  std::uint32_t ended = 0;
+  const std::size_t begin = b * pair_block_;
+  const std::size_t end = std::min(pairs, begin + pair_block_);
+  std::array<std::uint32_t, max_pair_block + lane_count> listed;
+  const std::size_t count = list_pairs_for_law(begin, end, particles_.size(), listed.data());
   evaluate_listed_pairs(b, listed.data(), count, dissipated, ended);
   pair_block_dissipated_[b] = dissipated;
   pair_block_ended_[b] = ended;
@@ -610,22 +618,23 @@ void World<D>::evaluate_pair_block(std::size_t b) {
 
 template <int D>
 void World<D>::evaluate_listed_pairs(std::size_t block, const std::uint32_t* listed,
-                                     std::size_t count, double& dissipated, std::uint32_t& ended) {
+                                     std::size_t count, double& dissipated, std::uint32_t& ended,
+                                     bool each_apart) {
 #if defined(__x86_64__)
   if (avx2_lanes_) {
-    evaluate_listed_pairs_avx2(block, listed, count, dissipated, ended);
+    evaluate_listed_pairs_avx2(block, listed, count, dissipated, ended, each_apart);
     return;
   }
 #endif
-  evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended);
+  evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, each_apart);
 }
 
 #if defined(__x86_64__)
 template <int D>
 void World<D>::evaluate_listed_pairs_avx2(std::size_t block, const std::uint32_t* listed,
                                           std::size_t count, double& dissipated,
-                                          std::uint32_t& ended) {
-  evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended);
+                                          std::uint32_t& ended, bool each_apart) {
+  evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, each_apart);
 }
 #endif
 
@@ -650,7 +659,7 @@ void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, st
 template <int D>
 void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint32_t* listed,
                                               std::size_t count, double& dissipated,
-                                              std::uint32_t& ended) {
+                                              std::uint32_t& ended, bool each_apart) {
   using T = Lanes;
   constexpr auto lanes = static_cast<std::size_t>(lane_count);
   // The particles' arrays the step reads, by the names the law uses: v and ω at the time of the
@@ -741,7 +750,7 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
       for (std::size_t l = 0; l < filled; ++l) {
         const std::uint32_t pair = q[l];
         if (overlaps[l] == 0) {
-          pair_ended_[begin + ended++] = {ContactType::ball_ball, history[pair].dissipated};
+          record_pair_end(pair, history[pair].dissipated, begin, ended, each_apart);
           touching[pair] = TouchState::apart;
           continue;
         }
@@ -750,7 +759,7 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
         add_to(particles_.force[j[l]], force_of[l]);
         particles_.torque[i[l]] += r[i[l]] * moment[l];
         particles_.torque[j[l]] += r[j[l]] * moment[l];
-        dissipated += out.dissipated[l];
+        record_pair_touch(pair, out.dissipated[l], dissipated, each_apart);
       }
       const T origin = kept(held.normal_spring_origin), spring_x = kept(held.tangential_spring[0]),
               spring_y = kept(held.tangential_spring[1]), energy = kept(held.dissipated),
@@ -766,7 +775,7 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
       for (std::size_t l = 0; l < filled; ++l) {
         const std::uint32_t pair = q[l];
         if (overlaps[l] == 0) {
-          pair_ended_[begin + ended++] = {ContactType::ball_ball, history[pair].dissipated};
+          record_pair_end(pair, history[pair].dissipated, begin, ended, each_apart);
           history[pair] = ContactHistory<D>{};
           touching[pair] = TouchState::apart;
           continue;
@@ -785,7 +794,7 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
         for (int d = 0; d < 3; ++d) turn[d] = moment[d][l];
         particles_.torque[i[l]] += r[i[l]] * turn;
         particles_.torque[j[l]] += r[j[l]] * turn;
-        dissipated += out.dissipated[l];
+        record_pair_touch(pair, out.dissipated[l], dissipated, each_apart);
       }
     }
   }
@@ -1226,29 +1235,30 @@ bool World<D>::run_stages_split_among_threads() {
           evaluate_pair_block(b);  // which starts at q and ends in this run
           q = std::min(pairs, (b + 1) * pair_block_);
         } else {
+          // This run's part of a block shared with another run or holding cross pairs: its own
+          // pairs through the kernel, each one's outcome kept apart; then the cross pairs'
+          // forces on their first particles, in pair order. That is each particle's order as
+          // on one thread: a particle's pairs as the first are sorted by the second, and a
+          // cross pair's second lies beyond this run, so its cross pairs come after all its
+          // other pairs, and no pair after them in the list holds it.
           const std::size_t end = std::min(own_pairs_end, (b + 1) * pair_block_);
-          for (; q < end; ++q) {
-            const std::uint32_t i = first[q];
-            const std::uint32_t j = second[q];
-            if (j >= own_end) {
-              if (pair_status_[q] == PairStatus::touching) {
-                force[i] -= cross_force_[c].force;
-                torque[i] += r[i] * cross_force_[c].moment;
-              }
-              ++c;
-              continue;
-            }
-            PairForce f;
-            const PairOutcome outcome = evaluate_pair(q, f);
-            pair_status_[q] = outcome.status;
-            pair_energy_[q] = outcome.energy;
-            if (outcome.status == PairStatus::touching) {
-              force[i] -= f.force;
-              torque[i] += r[i] * f.moment;
-              force[j] += f.force;
-              torque[j] += r[j] * f.moment;
+          for (std::size_t p = q; p < end; ++p) {
+            if (second[p] < own_end) pair_status_[p] = PairStatus::apart;
+          }
+          std::array<std::uint32_t, max_pair_block + lane_count> listed;
+          const std::size_t count = list_pairs_for_law(q, end, own_end, listed.data());
+          double unused_sum = 0.0;
+          std::uint32_t unused_count = 0;
+          evaluate_listed_pairs(b, listed.data(), count, unused_sum, unused_count, true);
+          for (; c < crossing && cross_pairs_[c] < end; ++c) {
+            const std::uint32_t cross = cross_pairs_[c];
+            const std::uint32_t i = first[cross];
+            if (pair_status_[cross] == PairStatus::touching) {
+              force[i] -= cross_force_[c].force;
+              torque[i] += r[i] * cross_force_[c].moment;
             }
           }
+          q = end;
         }
         run.advance_below(q < own_pairs_end ? std::size_t{first[q]} : std::size_t{own_end});
       }

@@ -242,22 +242,45 @@ class World {
   /// The pairs of block `block` listed in `listed` (those that overlap or did until now), in
   /// pair order, lane_count at a time (core/lanes.hpp): their contacts are worked out side by
   /// side, then each pair's outcome applied in pair order as one at a time would. Adds the
-  /// pairs' dissipation to `dissipated` and lists the collisions that end. Compiled twice, for
-  /// processors with AVX2 and for any x86-64; the same bits either way.
+  /// pairs' dissipation to `dissipated` and lists the collisions that end; or, with
+  /// `each_apart` (a block that two threads share), keeps each pair's outcome in pair_status_
+  /// and pair_energy_ instead, to be summed in pair order once both are done. Compiled twice,
+  /// for processors with AVX2 and for any x86-64; the same bits either way.
   void evaluate_listed_pairs(std::size_t block, const std::uint32_t* listed, std::size_t count,
-                             double& dissipated, std::uint32_t& ended);
+                             double& dissipated, std::uint32_t& ended, bool each_apart = false);
 #if defined(__x86_64__)
-  __attribute__((target("avx2"))) void evaluate_listed_pairs_avx2(std::size_t block,
-                                                                  const std::uint32_t* listed,
-                                                                  std::size_t count,
-                                                                  double& dissipated,
-                                                                  std::uint32_t& ended);
+  __attribute__((target("avx2"))) void evaluate_listed_pairs_avx2(
+      std::size_t block, const std::uint32_t* listed, std::size_t count, double& dissipated,
+      std::uint32_t& ended, bool each_apart);
 #endif
-  [[gnu::always_inline]] inline void evaluate_listed_pairs_in_lanes(std::size_t block,
-                                                                    const std::uint32_t* listed,
-                                                                    std::size_t count,
-                                                                    double& dissipated,
-                                                                    std::uint32_t& ended);
+  [[gnu::always_inline]] inline void evaluate_listed_pairs_in_lanes(
+      std::size_t block, const std::uint32_t* listed, std::size_t count, double& dissipated,
+      std::uint32_t& ended, bool each_apart);
+  /// Lists in `listed` the pairs of [begin, end) whose second particle is below `below` and that
+  /// overlap or did until now, in pair order, the last one repeated up to a whole group of
+  /// lanes; returns how many there are.
+  std::size_t list_pairs_for_law(std::size_t begin, std::size_t end, std::size_t below,
+                                 std::uint32_t* listed) const;
+  /// A listed pair's outcome: its collision ended with `energy`, or it touches and dissipated
+  /// `energy` in this step; into the block's sums, or kept apart (evaluate_listed_pairs).
+  [[gnu::always_inline]] void record_pair_end(std::uint32_t pair, double energy, std::size_t begin,
+                                              std::uint32_t& ended, bool each_apart) {
+    if (each_apart) {
+      pair_status_[pair] = PairStatus::ended;
+      pair_energy_[pair] = energy;
+    } else {
+      pair_ended_[begin + ended++] = {ContactType::ball_ball, energy};
+    }
+  }
+  [[gnu::always_inline]] void record_pair_touch(std::uint32_t pair, double energy,
+                                                double& dissipated, bool each_apart) {
+    if (each_apart) {
+      pair_status_[pair] = PairStatus::touching;
+      pair_energy_[pair] = energy;
+    } else {
+      dissipated += energy;
+    }
+  }
   /// Asks the processor to fetch what the pair kernel will read and write of listed pairs
   /// [begin, end): their history, and both particles' velocities, spins, masses and sums.
   [[gnu::always_inline]] inline void prefetch_pairs(const std::uint32_t* listed, std::size_t begin,
