@@ -48,8 +48,14 @@ class LinearSpringDashpot {
   double stored_energy(const ContactHistory<D>& history, double overlap) const {
     const double spring =
         std::max(0.0, normal_stiffness_ * (overlap - history.normal_spring_origin));
+    double tangential_squared = 0.0;
+    if constexpr (D == 2) {
+      tangential_squared = history.tangential_spring * history.tangential_spring;
+    } else {
+      tangential_squared = norm_squared(history.tangential_spring);
+    }
     return spring * spring / (2.0 * normal_stiffness_) +
-           norm_squared(history.tangential_spring) / (2.0 * tangential_stiffness_);
+           tangential_squared / (2.0 * tangential_stiffness_);
   }
 
   /// c_n = 2 ζ sqrt(k_n) sqrt(m*) and c_s = 2 ζ sqrt(k_s) sqrt(m*) for effective mass m*.
@@ -74,6 +80,82 @@ class LinearSpringDashpot {
                                                       const ContactDampingOf<T>& damping,
                                                       ContactHistory<D, T>& history,
                                                       double time_step) const {
+    if constexpr (D == 2) {
+      return evaluate_2d(in, damping, history, time_step);
+    } else {
+      return evaluate_3d(in, damping, history, time_step);
+    }
+  }
+
+ private:
+  /// 2D: the tangential spring is a signed length along the tangent t (contact.hpp), so that
+  /// R, turning it with the normal, is exact and free, and the Coulomb cap a comparison of
+  /// lengths: the same law as evaluate_3d's, with no square root or division in it.
+  template <class T>
+  [[gnu::always_inline]] ContactOutput<2, T> evaluate_2d(const ContactInput<2, T>& in,
+                                                         const ContactDampingOf<T>& damping,
+                                                         ContactHistory<2, T>& history,
+                                                         double time_step) const {
+    using V = Vec<2, T>;
+    const T dt = splat<T>(time_step);
+    const T k_n = splat<T>(normal_stiffness_);
+    const T k_s = splat<T>(tangential_stiffness_);
+    const V& n = in.normal;
+    const V t = tangent_of(n);
+    const T normal_speed = dot(in.velocity, n);                // v·n < 0 while the pair approaches
+    const T sliding = dot(in.velocity, t) + in.spin_velocity;  // v_s = sliding t
+    const T step_sliding = dot(in.step_velocity, t) + in.step_spin_velocity;
+
+    // Normal: spring k_n (δ − origin) and dashpot D_n = −c_n v_n, c_n = 2 ζ sqrt(k_n m*).
+    const T normal_damping = damping.normal;
+    const T normal_spring = k_n * (in.overlap - history.normal_spring_origin);
+    const T normal_force = normal_spring - normal_damping * normal_speed;
+
+    // R(F_s): the stored length along the tangent, which has turned with the normal.
+    const T spring_before = history.tangential_spring;
+
+    // No tension (as in evaluate_3d).
+    const Mask<T> breaks = allow_tension_ ? Mask<T>{} : normal_force <= 0.0;
+    const T held = select(T{} < normal_spring, normal_spring, T{});  // max(0, spring)
+    T broken_dissipated{};
+    if (any(breaks)) {
+      broken_dissipated = held * held / (2.0 * k_n) + spring_before * spring_before / (2.0 * k_s);
+    }
+    const T dashpot_dissipated = normal_damping * normal_speed * normal_speed * dt;
+
+    // Tangential spring and dashpot, capped at μ F_N as a whole (as in evaluate_3d); slipping,
+    // the force is μ F_N with the trial force's sign, carried by the spring alone.
+    const T spring = spring_before - k_s * (dt * step_sliding);
+    const T friction_limit = splat<T>(friction_) * lane_abs(normal_force);
+    const T tangential_damping = damping.tangential;
+    const T trial = spring - tangential_damping * sliding;
+    const Mask<T> slips = lane_abs(trial) > friction_limit;
+    const T slipping_spring = lane_copysign(friction_limit, trial);
+    const T slipping_dissipated =
+        dashpot_dissipated +
+        (-dt * (slipping_spring * sliding) +
+         (spring_before * spring_before - slipping_spring * slipping_spring) / (2.0 * k_s));
+    const T sticking_dissipated =
+        dashpot_dissipated + tangential_damping * (sliding * sliding) * dt;
+    const T tangential = select(slips, slipping_spring, trial);
+
+    ContactOutput<2, T> out;
+    out.tangential_force = select(breaks, V{}, tangential * t);
+    out.force = select(breaks, V{}, normal_force * n + tangential * t);
+    out.dissipated =
+        select(breaks, broken_dissipated, select(slips, slipping_dissipated, sticking_dissipated));
+    history.normal_spring_origin = select(breaks, in.overlap, history.normal_spring_origin);
+    history.tangential_spring = select(breaks, T{}, select(slips, slipping_spring, spring));
+    history.dissipated += out.dissipated;
+    return out;
+  }
+
+  template <class T>
+  [[gnu::always_inline]] ContactOutput<3, T> evaluate_3d(const ContactInput<3, T>& in,
+                                                         const ContactDampingOf<T>& damping,
+                                                         ContactHistory<3, T>& history,
+                                                         double time_step) const {
+    constexpr int D = 3;
     using V = Vec<D, T>;
     const T dt = splat<T>(time_step);
     const T k_n = splat<T>(normal_stiffness_);
@@ -90,7 +172,7 @@ class LinearSpringDashpot {
     const T normal_force = normal_spring - normal_damping * normal_speed;
 
     // R(F_s): turn the stored tangential spring into the current tangent plane, keeping its
-    // length (in 2D this is the exact rotation; in 3D a first-order one).
+    // length (a first-order rotation).
     const V stored = history.tangential_spring;
     const T spring_length_squared = norm_squared(stored);
     const V projected_spring = stored - dot(stored, n) * n;
@@ -152,7 +234,6 @@ class LinearSpringDashpot {
     return out;
   }
 
- private:
   double normal_stiffness_;
   double tangential_stiffness_;
   double damping_ratio_;

@@ -67,6 +67,16 @@ template <class M>
   return r;
 }
 
+/// The magnitude of the first with the sign of the second, in every lane as std::copysign.
+[[gnu::always_inline]] inline double lane_copysign(double magnitude, double sign) {
+  return __builtin_copysign(magnitude, sign);
+}
+[[gnu::always_inline]] inline Lanes lane_copysign(Lanes magnitude, Lanes sign) {
+  Lanes r;
+  for (int l = 0; l < lane_count; ++l) r[l] = __builtin_copysign(magnitude[l], sign[l]);
+  return r;
+}
+
 /// Lanes holding f(l) in lane l, for l = 0 … lane_count − 1 (f gives one double per lane).
 template <class F>
 [[gnu::always_inline]] inline Lanes gather_lanes(F&& f) {

@@ -79,6 +79,9 @@ inline double norm(const Vec<D>& a) {
 /// Angular velocity / torque: scalar about +z in 2D, a vector in 3D.
 template <int D>
 using Spin = std::conditional_t<D == 2, double, Vec3>;
+/// The same of some other number type T (double, or Lanes: core/lanes.hpp).
+template <int D, class T = double>
+using SpinOf = std::conditional_t<D == 2, T, Vec<3, T>>;
 
 /// n × s for a vector n and a spin s. In 2D s is along +z: (n_x, n_y, 0) × (0, 0, s).
 template <class T>

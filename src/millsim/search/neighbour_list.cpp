@@ -278,8 +278,9 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
   }
   // Carry the history of pairs kept from the old list, found among the old pairs of the lower
   // of the two old indices. A pair whose particles were renumbered in the other order has its
-  // bodies A and B swapped: its tangential spring, the force on B, changes sign (the other
-  // quantities of the history are the same for both bodies). On several threads from as many
+  // bodies A and B swapped: its tangential spring, the force on B, changes sign in 3D (in 2D
+  // it is a length along the tangent, which turns over with the normal; the other quantities
+  // of the history are the same for both bodies). On several threads from as many
   // particles as the search: a smaller world's step runs on one thread, and a parallel region
   // here at every rebuild kept a second core spinning through it (OpenMP's threads wait
   // actively for a while after each region).
@@ -305,7 +306,7 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
         if (second_[old] != b) continue;
         carried = history_[old];
         touched = touching_[old];
-        if (swapped) carried.tangential_spring = -carried.tangential_spring;
+        if (D == 3 && swapped) carried.tangential_spring = -carried.tangential_spring;
         break;
       }
     }

@@ -532,9 +532,9 @@ typename World<D>::PairOutcome World<D>::evaluate_pair(std::size_t q, PairForce&
   in.normal = offset * (1.0 / distance);
   in.overlap = reach - distance;
   in.velocity = v[j] - v[i];
-  in.spin_velocity = cross(in.normal, r[i] * w[i] + r[j] * w[j]);
+  in.spin_velocity = spin_sliding(in.normal, r[i] * w[i] + r[j] * w[j]);
   in.step_velocity = step_v[j] - step_v[i];
-  in.step_spin_velocity = cross(in.normal, r[i] * step_w[i] + r[j] * step_w[j]);
+  in.step_spin_velocity = spin_sliding(in.normal, r[i] * step_w[i] + r[j] * step_w[j]);
   touching[q] = TouchState::touching;
   history[q].overlap = in.overlap;
   // The dashpots' coefficients from the pair's effective mass, worked out here rather than
@@ -716,23 +716,22 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
     in.overlap = reach - distance;
     in.velocity = velocity;
     in.step_velocity = step_velocity;
-    // n × (r_i ω_i + r_j ω_j), at the time of the positions and over the last step.
-    in.spin_velocity = cross(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
-                               return r[i[l]] * w[i[l]] + r[j[l]] * w[j[l]];
-                             }));
-    in.step_spin_velocity =
-        cross(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
-                return r[i[l]] * p.angular_velocity[i[l]] + r[j[l]] * p.angular_velocity[j[l]];
-              }));
+    // The spins' sliding velocity from r_i ω_i + r_j ω_j, at the time of the positions and over
+    // the last step.
+    in.spin_velocity = spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
+                                      return r[i[l]] * w[i[l]] + r[j[l]] * w[j[l]];
+                                    }));
+    in.step_spin_velocity = spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
+                                           return r[i[l]] * p.angular_velocity[i[l]] +
+                                                  r[j[l]] * p.angular_velocity[j[l]];
+                                         }));
     const T mass_i = gather_lanes([&](std::size_t l) { return p.mass[i[l]]; });
     const T mass_j = gather_lanes([&](std::size_t l) { return p.mass[j[l]]; });
     ContactHistory<D, T> held;
     held.normal_spring_origin =
         gather_lanes([&](std::size_t l) { return history[q[l]].normal_spring_origin; });
-    for (int d = 0; d < D; ++d) {
-      held.tangential_spring[d] =
-          gather_lanes([&](std::size_t l) { return history[q[l]].tangential_spring[d]; });
-    }
+    held.tangential_spring =
+        gather_spin_lanes<D>([&](std::size_t l) { return history[q[l]].tangential_spring; });
     held.dissipated = gather_lanes([&](std::size_t l) { return history[q[l]].dissipated; });
     const ContactDampingOf<T> damping = ball_ball_law_.damping(mass_i * mass_j / (mass_i + mass_j));
     const ContactOutput<D, T> out = ball_ball_law_.evaluate(in, damping, held, dt);
@@ -761,13 +760,12 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
         particles_.torque[j[l]] += r[j[l]] * moment[l];
         record_pair_touch(pair, out.dissipated[l], dissipated, each_apart);
       }
-      const T origin = kept(held.normal_spring_origin), spring_x = kept(held.tangential_spring[0]),
-              spring_y = kept(held.tangential_spring[1]), energy = kept(held.dissipated),
-              overlap = kept(in.overlap);
+      const T origin = kept(held.normal_spring_origin), spring = kept(held.tangential_spring),
+              energy = kept(held.dissipated), overlap = kept(in.overlap);
       for (std::size_t l = 0; l < lanes; ++l) {
         ContactHistory<D>& h = history[q[l]];
         h.normal_spring_origin = origin[l];
-        h.tangential_spring = {{spring_x[l], spring_y[l]}};
+        h.tangential_spring = spring[l];
         h.dissipated = energy[l];
         h.overlap = overlap[l];
       }
@@ -962,13 +960,14 @@ void World<D>::evaluate_wall_laws_in_lanes(WallWork* work, std::size_t count) {
     }
     in.overlap = gather_lanes([&](std::size_t l) { return c[l]->contact.overlap; });
     const T radius = gather_lanes([&](std::size_t l) { return p.radius[particle(l)]; });
-    // n × r ω, at the time of the positions and over the last step.
-    in.spin_velocity = cross(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
-                               return p.radius[particle(l)] * spin_now_[particle(l)];
-                             }));
-    in.step_spin_velocity = cross(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
-                                    return p.radius[particle(l)] * p.angular_velocity[particle(l)];
-                                  }));
+    // The spin's sliding velocity from r ω, at the time of the positions and over the last step.
+    in.spin_velocity = spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
+                                      return p.radius[particle(l)] * spin_now_[particle(l)];
+                                    }));
+    in.step_spin_velocity =
+        spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
+                       return p.radius[particle(l)] * p.angular_velocity[particle(l)];
+                     }));
     // The dashpots' coefficients from the particle's mass (m* = m against a wall), worked out
     // here as the pair kernel does, not kept per particle.
     const ContactDampingOf<T> damping =
@@ -979,17 +978,19 @@ void World<D>::evaluate_wall_laws_in_lanes(WallWork* work, std::size_t count) {
     };
     held.normal_spring_origin =
         gather_lanes([&](std::size_t l) { return history(l).normal_spring_origin; });
-    for (int d = 0; d < D; ++d) {
-      held.tangential_spring[d] =
-          gather_lanes([&](std::size_t l) { return history(l).tangential_spring[d]; });
-    }
+    held.tangential_spring =
+        gather_spin_lanes<D>([&](std::size_t l) { return history(l).tangential_spring; });
     held.dissipated = gather_lanes([&](std::size_t l) { return history(l).dissipated; });
     const ContactOutput<D, T> out = ball_wall_law_.evaluate(in, damping, held, dt);
     const auto moment = -radius * cross(in.normal, out.tangential_force);
     for (std::size_t l = 0; l < filled; ++l) {
       ContactHistory<D>& h = history(l);
       h.normal_spring_origin = held.normal_spring_origin[l];
-      for (int d = 0; d < D; ++d) h.tangential_spring[d] = held.tangential_spring[d][l];
+      if constexpr (D == 2) {
+        h.tangential_spring = held.tangential_spring[l];
+      } else {
+        for (int d = 0; d < D; ++d) h.tangential_spring[d] = held.tangential_spring[d][l];
+      }
       h.dissipated = held.dissipated[l];
       h.overlap = in.overlap[l];
       WallWork& done = *c[l];
