@@ -6,7 +6,6 @@
 #pragma once
 
 #include <cstddef>
-#include <cstdint>
 #include <cstring>
 #include <utility>
 
@@ -113,8 +112,6 @@ template <class T>
 /// A 2D vector's two components in one register (SSE2), for the pair kernel's gathers and sums
 /// in 2D: the same operations on each component as on a Vec<2>.
 using Pair2 = double __attribute__((vector_size(sizeof(double) * 2)));
-/// Lane indices for __builtin_shuffle of Lanes.
-using LaneIndex = std::int64_t __attribute__((vector_size(sizeof(std::int64_t) * lane_count)));
 
 [[gnu::always_inline]] inline Pair2 pair_of(const Vec<2>& a) {
   Pair2 r;
@@ -141,14 +138,13 @@ template <class F>
   const Pair2 p0 = pair_of(f(0)), p1 = pair_of(f(1)), p2 = pair_of(f(2)), p3 = pair_of(f(3));
   const Lanes a = {p0[0], p0[1], p2[0], p2[1]};
   const Lanes b = {p1[0], p1[1], p3[0], p3[1]};
-  return {{__builtin_shuffle(a, b, LaneIndex{0, 4, 2, 6}),
-           __builtin_shuffle(a, b, LaneIndex{1, 5, 3, 7})}};
+  return {{__builtin_shufflevector(a, b, 0, 4, 2, 6), __builtin_shufflevector(a, b, 1, 5, 3, 7)}};
 }
 
 /// The 2D vector of each lane: the inverse of lanes_of.
 [[gnu::always_inline]] inline std::array<Pair2, lane_count> pairs_of(const Vec<2, Lanes>& v) {
-  const Lanes low = __builtin_shuffle(v[0], v[1], LaneIndex{0, 4, 2, 6});   // x0 y0 x2 y2
-  const Lanes high = __builtin_shuffle(v[0], v[1], LaneIndex{1, 5, 3, 7});  // x1 y1 x3 y3
+  const Lanes low = __builtin_shufflevector(v[0], v[1], 0, 4, 2, 6);   // x0 y0 x2 y2
+  const Lanes high = __builtin_shufflevector(v[0], v[1], 1, 5, 3, 7);  // x1 y1 x3 y3
   return {Pair2{low[0], low[1]}, Pair2{high[0], high[1]}, Pair2{low[2], low[3]},
           Pair2{high[2], high[3]}};
 }
