@@ -138,16 +138,9 @@ class LinearSpringDashpot {
     const T sticking_dissipated =
         dashpot_dissipated + tangential_damping * (sliding * sliding) * dt;
     const T tangential = select(slips, slipping_spring, trial);
-
-    ContactOutput<2, T> out;
-    out.tangential_force = select(breaks, V{}, tangential * t);
-    out.force = select(breaks, V{}, normal_force * n + tangential * t);
-    out.dissipated =
-        select(breaks, broken_dissipated, select(slips, slipping_dissipated, sticking_dissipated));
-    history.normal_spring_origin = select(breaks, in.overlap, history.normal_spring_origin);
-    history.tangential_spring = select(breaks, T{}, select(slips, slipping_spring, spring));
-    history.dissipated += out.dissipated;
-    return out;
+    return conclude(in, history, {breaks, slips}, normal_force, tangential * t,
+                    {broken_dissipated, slipping_dissipated, sticking_dissipated},
+                    select(slips, slipping_spring, spring));
   }
 
   template <class T>
@@ -222,14 +215,39 @@ class LinearSpringDashpot {
     const T sticking_dissipated =
         dashpot_dissipated + tangential_damping * norm_squared(sliding_velocity) * dt;
     const V tangential_force = select(slips, slipping_spring, trial);
+    return conclude(in, history, {breaks, slips}, normal_force, tangential_force,
+                    {broken_dissipated, slipping_dissipated, sticking_dissipated},
+                    select(slips, slipping_spring, spring));
+  }
 
+  /// Which way a contact went: it broke (no tension), or it slips.
+  template <class T>
+  struct Outcome {
+    Mask<T> breaks;
+    Mask<T> slips;
+  };
+  /// The energy it dissipated this step if it broke, slipped or stuck.
+  template <class T>
+  struct Dissipated {
+    T broken;
+    T slipping;
+    T sticking;
+  };
+  /// The law's last part in 2D and 3D: the force (none where the contact broke) and the
+  /// energy of its outcome; the history forgets the springs where it broke and keeps the
+  /// tangential spring `kept` otherwise.
+  template <int D, class T>
+  [[gnu::always_inline]] static ContactOutput<D, T> conclude(
+      const ContactInput<D, T>& in, ContactHistory<D, T>& history, const Outcome<T>& outcome,
+      T normal_force, const Vec<D, T>& tangential_force, const Dissipated<T>& dissipated,
+      const SpinOf<D, T>& kept) {
     ContactOutput<D, T> out;
-    out.tangential_force = select(breaks, V{}, tangential_force);
-    out.force = select(breaks, V{}, normal_force * n + tangential_force);
-    out.dissipated =
-        select(breaks, broken_dissipated, select(slips, slipping_dissipated, sticking_dissipated));
-    history.normal_spring_origin = select(breaks, in.overlap, history.normal_spring_origin);
-    history.tangential_spring = select(breaks, V{}, select(slips, slipping_spring, spring));
+    out.tangential_force = select(outcome.breaks, Vec<D, T>{}, tangential_force);
+    out.force = select(outcome.breaks, Vec<D, T>{}, normal_force * in.normal + tangential_force);
+    out.dissipated = select(outcome.breaks, dissipated.broken,
+                            select(outcome.slips, dissipated.slipping, dissipated.sticking));
+    history.normal_spring_origin = select(outcome.breaks, in.overlap, history.normal_spring_origin);
+    history.tangential_spring = select(outcome.breaks, SpinOf<D, T>{}, kept);
     history.dissipated += out.dissipated;
     return out;
   }
