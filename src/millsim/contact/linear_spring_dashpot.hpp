@@ -90,7 +90,8 @@ class LinearSpringDashpot {
  private:
   /// 2D: the tangential spring is a signed length along the tangent t (contact.hpp), so that
   /// R, turning it with the normal, is exact and free, and the Coulomb cap a comparison of
-  /// lengths: the same law as evaluate_3d's, with no square root or division in it.
+  /// lengths: the same law as evaluate_3d's, with no square root, and no division on the way to
+  /// the force (the energy accounts still divide by 2 k).
   template <class T>
   [[gnu::always_inline]] ContactOutput<2, T> evaluate_2d(const ContactInput<2, T>& in,
                                                          const ContactDampingOf<T>& damping,
