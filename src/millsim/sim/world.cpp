@@ -743,8 +743,9 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
       // The histories of the four lanes, written without a branch after the ended pairs'
       // energies are read: those of ended pairs zeroed, the rest the law's (a lane that repeats
       // the last pair writes what that one does).
+      // (No lambda for the choice: one that takes Lanes by value would be a call in the debug
+      // build, from AVX2 code into baseline code: core/vec.hpp.)
       const T zero{};
-      const auto kept = [&](T value) { return select(overlaps, value, zero); };
       const std::array<Pair2, lanes> force_of = pairs_of(out.force);
       for (std::size_t l = 0; l < filled; ++l) {
         const std::uint32_t pair = q[l];
@@ -760,8 +761,10 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
         particles_.torque[j[l]] += r[j[l]] * moment[l];
         record_pair_touch(pair, out.dissipated[l], dissipated, each_apart);
       }
-      const T origin = kept(held.normal_spring_origin), spring = kept(held.tangential_spring),
-              energy = kept(held.dissipated), overlap = kept(in.overlap);
+      const T origin = select(overlaps, held.normal_spring_origin, zero);
+      const T spring = select(overlaps, held.tangential_spring, zero);
+      const T energy = select(overlaps, held.dissipated, zero);
+      const T overlap = select(overlaps, in.overlap, zero);
       for (std::size_t l = 0; l < lanes; ++l) {
         ContactHistory<D>& h = history[q[l]];
         h.normal_spring_origin = origin[l];
