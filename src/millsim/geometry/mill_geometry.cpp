@@ -144,16 +144,17 @@ bool on_shell_side(const Mill3D& mill, const Vec2& planar_centre, double z) {
   return norm(planar_centre) - mill.radius > beyond * std::tan(mill.cone_angle);
 }
 
-/// A 3D contact from the in-plane one found on the cross-section, at height z.
-WallContact<3> extrude(const WallContact<2>& planar, double z) {
-  WallContact<3> contact;
+/// A 3D contact from the in-plane one found on the cross-section, at height z, written into
+/// `contact` field by field. (Returned by value, it was made in a zeroed temporary and copied
+/// in pieces wider than the stores that had just made them, which the processor cannot forward:
+/// bench/results.md.)
+void extrude(const WallContact<2>& planar, double z, WallContact<3>& contact) {
   contact.wall_id = planar.wall_id;
   contact.kind = planar.kind;
   contact.normal = Vec3{{planar.normal[0], planar.normal[1], 0.0}};
   contact.overlap = planar.overlap;
   contact.point = Vec3{{planar.point[0], planar.point[1], z}};
   contact.wall_velocity = Vec3{{planar.wall_velocity[0], planar.wall_velocity[1], 0.0}};
-  return contact;
 }
 
 /// A contact with an end wall of a 3D mill, a surface of revolution about the z axis, from
@@ -290,7 +291,7 @@ int mill_contacts(const Mill3D& mill, const Vec3& centre, double particle_radius
   const double z = centre[2];
   WallContact<2> found;
   if (shell_contact(mill, planar, particle_radius, found) && on_shell_side(mill, planar, z)) {
-    out[count++] = extrude(found, z);
+    extrude(found, z, out[count++]);
   }
   if ((nearby == nullptr || nearby->count != 0) &&
       !beyond_lifter_reach(mill, planar, particle_radius)) {
@@ -301,7 +302,7 @@ int mill_contacts(const Mill3D& mill, const Vec3& centre, double particle_radius
     for_each_lifter_to_test(mill, planar, nearby, [&](int index) {
       if (!lifter_contact(mill, index, planar, std::abs(axial), particle_radius, found)) return;
       WallContact<3>& contact = out[count++];
-      contact = extrude(found, bar_z);
+      extrude(found, bar_z, contact);
       if (axial != 0.0) contact.normal[2] = axial / (particle_radius - found.overlap);
     });
   }

@@ -125,6 +125,12 @@ struct Walls {
   template <typename Emit>
   void for_each_contact(const Vec<D>& centre, double particle_radius, Emit&& emit,
                         const NearbyLifters* nearby = nullptr) const;
+  /// The same contacts in the same order, written into `out` (room for max_contacts()); returns
+  /// how many. The wall stage's way: each contact is made where the contact law reads it.
+  int contacts_of(const Vec<D>& centre, double particle_radius, WallContact<D>* out,
+                  const NearbyLifters* nearby = nullptr) const;
+  /// Most contacts one particle can have with these walls.
+  std::size_t max_contacts() const;
 };
 
 /// Closest-feature contact of a disc with the mill; in mill_geometry.cpp.
@@ -164,28 +170,42 @@ template <int D>
 template <typename Emit>
 void Walls<D>::for_each_contact(const Vec<D>& centre, double particle_radius, Emit&& emit,
                                 const NearbyLifters* nearby) const {
+  // One buffer per thread, grown once: a fresh array here was zeroed for every call.
+  static thread_local std::vector<WallContact<D>> found;
+  if (found.size() < max_contacts()) found.resize(max_contacts());
+  const int count = contacts_of(centre, particle_radius, found.data(), nearby);
+  for (int k = 0; k < count; ++k) emit(found[static_cast<std::size_t>(k)]);
+}
+
+template <int D>
+int Walls<D>::contacts_of(const Vec<D>& centre, double particle_radius, WallContact<D>* out,
+                          const NearbyLifters* nearby) const {
+  // mill_contacts and the planes below write every field of each contact they report, so
+  // nothing of an earlier call is read.
+  int count = 0;
   int id_offset = 0;
   if (mill) {
-    // One buffer per thread, made once: a fresh array here was zeroed for every wall candidate
-    // and step (528 bytes in 3D, 4 % of the 3D step's instructions). mill_contacts writes every
-    // field of each contact it reports, so nothing of an earlier call is read.
-    static thread_local WallContact<D> found[max_mill_contacts<D>];
-    const int count = mill_contacts(*mill, centre, particle_radius, found, nearby);
-    for (int k = 0; k < count; ++k) emit(found[k]);
+    count = mill_contacts(*mill, centre, particle_radius, out, nearby);
     id_offset = mill_wall_count();
   }
   for (std::size_t p = 0; p < planes.size(); ++p) {
     const Plane<D>& plane = planes[p];
     const double distance = dot(centre - plane.point, plane.normal);
     if (distance >= particle_radius) continue;
-    WallContact<D> contact;
+    WallContact<D>& contact = out[count++];
     contact.wall_id = id_offset + static_cast<int>(p);
     contact.kind = WallKind::plane;
     contact.normal = plane.normal;
     contact.overlap = particle_radius - distance;
     contact.point = centre - distance * plane.normal;
-    emit(contact);
+    contact.wall_velocity = Vec<D>{};
   }
+  return count;
+}
+
+template <int D>
+std::size_t Walls<D>::max_contacts() const {
+  return (mill ? static_cast<std::size_t>(max_mill_contacts<D>) : 0) + planes.size();
 }
 
 }  // namespace millsim

@@ -838,11 +838,14 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
   const std::size_t begin = b * wall_block_;
   const std::size_t end = std::min(candidates, begin + wall_block_);
   // The block's contacts, found candidate by candidate (each in its slot of wall-contact
-  // history), then their contact law worked out lane_count at a time, then each candidate's
-  // contacts added up in the order they were found. One list per thread, kept.
+  // history) and written where the law reads them, then their contact law worked out
+  // lane_count at a time, then each candidate's contacts added up in the order they were found.
+  // One list per thread, kept.
+  static thread_local std::vector<WallContact<D>> found_list;
   static thread_local std::vector<WallWork> work_list;
   static thread_local std::vector<std::uint32_t> first_work;
-  work_list.clear();
+  const std::size_t most = walls_.max_contacts();
+  std::size_t found = 0;
   first_work.assign(end - begin + 1, 0);
   for (std::size_t k = begin; k < end; ++k) {
     const std::uint32_t i = wall_candidates_[k];
@@ -850,27 +853,34 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
     ContactHistory<D>* slot_history = &wall_slot_history_[k * max_wall_contacts];
     unsigned seen = 0;  // bit s: slot s touched now
     const NearbyLifters* nearby = nearby_lifters_.empty() ? nullptr : &nearby_lifters_[k];
-    walls_.for_each_contact(
-        particles_.position[i], particles_.radius[i],
-        [&](const WallContact<D>& contact) {
-          int slot = 0;
-          while (slot < max_wall_contacts && slot_id[slot] != contact.wall_id) ++slot;
-          if (slot == max_wall_contacts) {
-            slot = 0;
-            while (slot < max_wall_contacts && slot_id[slot] >= 0) ++slot;
-            if (slot == max_wall_contacts) return;  // cannot happen: see max_wall_contacts
-            slot_id[slot] = contact.wall_id;
-          }
-          seen |= 1U << static_cast<unsigned>(slot);
-          WallWork found;
-          found.particle = i;
-          found.slot =
-              static_cast<std::uint32_t>(k * max_wall_contacts) + static_cast<std::uint32_t>(slot);
-          found.contact = contact;
-          work_list.push_back(found);
-        },
-        nearby);
-    first_work[k - begin + 1] = static_cast<std::uint32_t>(work_list.size());
+    if (found_list.size() < found + most) {
+      found_list.resize(std::max(2 * found_list.size(), found + most));
+      work_list.resize(found_list.size());
+    }
+    WallContact<D>* contact = &found_list[found];
+    const int count =
+        walls_.contacts_of(particles_.position[i], particles_.radius[i], contact, nearby);
+    int kept_count = 0;
+    for (int c = 0; c < count; ++c) {
+      const int wall_id = contact[c].wall_id;
+      int slot = 0;
+      while (slot < max_wall_contacts && slot_id[slot] != wall_id) ++slot;
+      if (slot == max_wall_contacts) {
+        slot = 0;
+        while (slot < max_wall_contacts && slot_id[slot] >= 0) ++slot;
+        if (slot == max_wall_contacts) continue;  // cannot happen: see max_wall_contacts
+        slot_id[slot] = wall_id;
+      }
+      seen |= 1U << static_cast<unsigned>(slot);
+      if (kept_count != c) contact[kept_count] = contact[c];
+      WallWork& work_of = work_list[found + static_cast<std::size_t>(kept_count)];
+      work_of.particle = i;
+      work_of.slot =
+          static_cast<std::uint32_t>(k * max_wall_contacts) + static_cast<std::uint32_t>(slot);
+      ++kept_count;
+    }
+    found += static_cast<std::size_t>(kept_count);
+    first_work[k - begin + 1] = static_cast<std::uint32_t>(found);
     // Slots of walls the candidate no longer touches: their collisions have ended. (The law
     // below works on the touched slots alone.)
     unsigned held = 0;  // bit s: slot s holds a wall's history
@@ -885,7 +895,7 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
       slot_id[slot] = -1;
     }
   }
-  evaluate_wall_laws(work_list.data(), work_list.size());
+  evaluate_wall_laws(found_list.data(), work_list.data(), found);
   for (std::size_t k = begin; k < end; ++k) {
     // A candidate touching no wall adds nothing: its sums, begun at +0 and so never −0 (in
     // round-to-nearest x + y is −0 only if both are), would stay the same bits.
@@ -898,12 +908,13 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
     Spin<D> moment{};
     for (std::uint32_t w = first_work[k - begin]; w < first_work[k - begin + 1]; ++w) {
       const WallWork& done = work_list[w];
+      const WallContact<D>& contact = found_list[w];
       force += done.force;
       moment += done.moment;
       dissipated += done.dissipated;
-      if (done.contact.kind != WallKind::plane) {
-        torque += axial_moment(done.contact.point, done.force);
-        work += dot(done.force, done.contact.wall_velocity) * dt;
+      if (contact.kind != WallKind::plane) {
+        torque += axial_moment(contact.point, done.force);
+        work += dot(done.force, contact.wall_velocity) * dt;
       }
     }
     // Added to the particle's sums after its pairs (they are all done), before gravity; or
@@ -922,25 +933,28 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
 }
 
 template <int D>
-void World<D>::evaluate_wall_laws(WallWork* work, std::size_t count) {
+void World<D>::evaluate_wall_laws(const WallContact<D>* contact, WallWork* work,
+                                  std::size_t count) {
 #if defined(__x86_64__)
   if (avx2_lanes_) {
-    evaluate_wall_laws_avx2(work, count);
+    evaluate_wall_laws_avx2(contact, work, count);
     return;
   }
 #endif
-  evaluate_wall_laws_in_lanes(work, count);
+  evaluate_wall_laws_in_lanes(contact, work, count);
 }
 
 #if defined(__x86_64__)
 template <int D>
-void World<D>::evaluate_wall_laws_avx2(WallWork* work, std::size_t count) {
-  evaluate_wall_laws_in_lanes(work, count);
+void World<D>::evaluate_wall_laws_avx2(const WallContact<D>* contact, WallWork* work,
+                                       std::size_t count) {
+  evaluate_wall_laws_in_lanes(contact, work, count);
 }
 #endif
 
 template <int D>
-void World<D>::evaluate_wall_laws_in_lanes(WallWork* work, std::size_t count) {
+void World<D>::evaluate_wall_laws_in_lanes(const WallContact<D>* contact, WallWork* work,
+                                           std::size_t count) {
   using T = Lanes;
   constexpr auto lanes = static_cast<std::size_t>(lane_count);
   const double dt = settings_.time_step;
@@ -949,19 +963,21 @@ void World<D>::evaluate_wall_laws_in_lanes(WallWork* work, std::size_t count) {
     // The contacts of the lanes; where fewer remain, the last one fills the rest.
     const std::size_t filled = std::min(lanes, count - k);
     std::array<WallWork*, lanes> c{};
-    for (std::size_t l = 0; l < lanes; ++l) c[l] = &work[k + std::min(l, filled - 1)];
+    std::array<const WallContact<D>*, lanes> wall{};
+    for (std::size_t l = 0; l < lanes; ++l) {
+      c[l] = &work[k + std::min(l, filled - 1)];
+      wall[l] = &contact[k + std::min(l, filled - 1)];
+    }
     const auto particle = [&](std::size_t l) { return c[l]->particle; };
     ContactInput<D, T> in;
     for (int d = 0; d < D; ++d) {
-      in.normal[d] = gather_lanes([&](std::size_t l) { return c[l]->contact.normal[d]; });
-      in.velocity[d] = gather_lanes([&](std::size_t l) {
-        return velocity_now_[particle(l)][d] - c[l]->contact.wall_velocity[d];
-      });
-      in.step_velocity[d] = gather_lanes([&](std::size_t l) {
-        return p.velocity[particle(l)][d] - c[l]->contact.wall_velocity[d];
-      });
+      in.normal[d] = gather_lanes([&](std::size_t l) { return wall[l]->normal[d]; });
+      in.velocity[d] = gather_lanes(
+          [&](std::size_t l) { return velocity_now_[particle(l)][d] - wall[l]->wall_velocity[d]; });
+      in.step_velocity[d] = gather_lanes(
+          [&](std::size_t l) { return p.velocity[particle(l)][d] - wall[l]->wall_velocity[d]; });
     }
-    in.overlap = gather_lanes([&](std::size_t l) { return c[l]->contact.overlap; });
+    in.overlap = gather_lanes([&](std::size_t l) { return wall[l]->overlap; });
     const T radius = gather_lanes([&](std::size_t l) { return p.radius[particle(l)]; });
     // The spin's sliding velocity from r ω, at the time of the positions and over the last step.
     in.spin_velocity = spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {

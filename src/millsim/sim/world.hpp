@@ -298,11 +298,11 @@ class World {
   /// each; returns whether any call returned true.
   template <class Body>
   bool for_each_particle_run(Body&& body);
-  /// A wall contact of a candidate: where its history is, and what the contact law made of it.
+  /// A wall contact of a candidate (the contact itself is kept beside it, in an array of
+  /// WallContact): where its history is, and what the contact law made of it.
   struct WallWork {
     std::uint32_t particle = 0;
     std::uint32_t slot = 0;  ///< in wall_slot_history_
-    WallContact<D> contact;
     Vec<D> force{};
     Spin<D> moment{};  ///< −r n × F_t
     double dissipated = 0.0;
@@ -310,11 +310,13 @@ class World {
   /// The contact law of `count` wall contacts, lane_count at a time (core/lanes.hpp): each
   /// contact's force, moment and dissipation, and its history updated. Compiled twice, as
   /// evaluate_listed_pairs is; the same bits as the law on one contact.
-  void evaluate_wall_laws(WallWork* work, std::size_t count);
+  void evaluate_wall_laws(const WallContact<D>* contact, WallWork* work, std::size_t count);
 #if defined(__x86_64__)
-  __attribute__((target("avx2"))) void evaluate_wall_laws_avx2(WallWork* work, std::size_t count);
+  __attribute__((target("avx2"))) void evaluate_wall_laws_avx2(const WallContact<D>* contact,
+                                                               WallWork* work, std::size_t count);
 #endif
-  [[gnu::always_inline]] inline void evaluate_wall_laws_in_lanes(WallWork* work, std::size_t count);
+  [[gnu::always_inline]] inline void evaluate_wall_laws_in_lanes(const WallContact<D>* contact,
+                                                                 WallWork* work, std::size_t count);
   void refresh_nearby_lifters();
   bool lifters_moved_too_far() const;
   void evaluate_wall_contacts();
