@@ -70,7 +70,6 @@ void expect_default(const ContactHistory<D>& h) {
   EXPECT_EQ(h.normal_spring_origin, 0.0);
   EXPECT_EQ(h.tangential_spring, SpinOf<D>{});
   EXPECT_EQ(h.dissipated, 0.0);
-  EXPECT_EQ(h.overlap, 0.0);
 }
 
 // 300 particles, radii uniform in [0.5, 1.5], placed independently (so some overlap), skin 0.3.
@@ -292,7 +291,6 @@ void check_history_carry_over() {
     ContactHistory<D>& h = list.history()[p];
     h.dissipated = m;
     h.normal_spring_origin = -m;
-    h.overlap = 2.0 * m;
     if constexpr (D == 2) {
       h.tangential_spring = 3.0 * m;
     } else {
@@ -330,7 +328,6 @@ void check_history_carry_over() {
       const double m = found->second;
       EXPECT_EQ(h.dissipated, m);
       EXPECT_EQ(h.normal_spring_origin, -m);
-      EXPECT_EQ(h.overlap, 2.0 * m);
       if constexpr (D == 2) {
         EXPECT_EQ(h.tangential_spring, 3.0 * m);
       } else {

@@ -19,7 +19,6 @@ struct ContactHistory {
   /// exactly, with no length to restore.
   SpinOf<D, T> tangential_spring{};
   T dissipated{};  ///< energy dissipated since the bodies first touched, J
-  T overlap{};     ///< δ at the last evaluation, m (for the stored-energy account)
 };
 
 /// Geometry and relative motion of one contact, body B relative to body A.

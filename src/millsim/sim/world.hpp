@@ -298,6 +298,11 @@ class World {
   /// each; returns whether any call returned true.
   template <class Body>
   bool for_each_particle_run(Body&& body);
+  /// A wall slot's history, with the overlap its stored-energy account needs (a pair's is
+  /// worked out from the positions instead: stored_spring_energy).
+  struct WallHistory : ContactHistory<D> {
+    double overlap = 0.0;  ///< δ at the last evaluation, m
+  };
   /// A wall contact of a candidate (the contact itself is kept beside it, in an array of
   /// WallContact): where its history is, and what the contact law made of it.
   struct WallWork {
@@ -439,7 +444,7 @@ class World {
   // (no_wall_slots: none, it is not a candidate); and the arrays the next rebuild fills.
   static constexpr std::uint32_t no_wall_slots = 0xffffffffU;
   std::vector<std::int32_t> wall_slot_id_, next_wall_slot_id_;
-  std::vector<ContactHistory<D>> wall_slot_history_, next_wall_slot_history_;
+  std::vector<WallHistory> wall_slot_history_, next_wall_slot_history_;
   std::vector<std::uint32_t> wall_slots_of_;
   // Per wall candidate, the lifters it may touch until the next rebuild or until the lifters
   // have moved lifter_travel_ (arc length at the shell) since they were listed, at mill angle
