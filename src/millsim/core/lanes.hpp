@@ -121,6 +121,12 @@ using Pair2 = double __attribute__((vector_size(sizeof(double) * 2)));
 [[gnu::always_inline]] inline Pair2 pair_of(Pair2 a) {
   return a;
 }
+/// A 3D vector's first two components in one register.
+[[gnu::always_inline]] inline Pair2 planar_pair_of(const Vec<3>& a) {
+  Pair2 r;
+  std::memcpy(&r, a.c.data(), sizeof r);
+  return r;
+}
 /// a += b and a −= b, both components at once.
 [[gnu::always_inline]] inline void add_to(Vec<2>& a, Pair2 b) {
   const Pair2 sum = pair_of(a) + b;

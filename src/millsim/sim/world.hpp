@@ -261,6 +261,11 @@ class World {
   /// lanes; returns how many there are.
   std::size_t list_pairs_for_law(std::size_t begin, std::size_t end, std::size_t below,
                                  std::uint32_t* listed) const;
+  /// The same for a world periodic or not, and for `below` at or beyond the last particle
+  /// (every pair is the caller's) or not.
+  template <bool periodic, bool every_pair>
+  std::size_t list_pairs_of(std::size_t begin, std::size_t end, std::size_t below,
+                            std::uint32_t* listed) const;
   /// A listed pair's outcome: its collision ended with `energy`, or it touches and dissipated
   /// `energy` in this step; into the block's sums, or kept apart (evaluate_listed_pairs).
   [[gnu::always_inline]] void record_pair_end(std::uint32_t pair, double energy, std::size_t begin,
