@@ -136,8 +136,9 @@ class World {
     nearby_lifter_lists_ = on;
     nearby_lifters_.clear();
   }
-  /// Whether the pair and wall stages' lanes (core/lanes.hpp) use AVX2 instructions, as they do by
-  /// default where the processor has them; off, the instructions of any x86-64 processor. The
+  /// Whether the pair and wall stages' lanes (core/lanes.hpp) and the integration use AVX2
+  /// instructions, as they do by default where the processor has them; off, the instructions of
+  /// any x86-64 processor. The
   /// results are the same bit for bit either way; tests switch it off to show that.
   void set_avx2_lanes(bool on);
   bool avx2_lanes() const { return avx2_lanes_; }
@@ -347,13 +348,13 @@ class World {
   bool accumulate_forces_and_integrate();
   /// Particles [begin, end) advanced by the loop for this world (integrate_particles).
   bool integrate_run(std::size_t begin, std::size_t end);
-  /// Its loop over particles [begin, end), for a periodic slab or not. In 2D the one without a
-  /// period is compiled twice, for processors with AVX2 (two discs in a register, where the
-  /// other works on one) and for any x86-64, the same bits either way.
+  /// Its loop over particles [begin, end), for a periodic slab or not. The one without a period
+  /// has a second version for processors with AVX2, the same bits either way: in 2D the same
+  /// loop compiled again (two discs in a register, where the other works on one), in 3D four
+  /// spheres at a time (integrate_spheres_avx2).
   template <bool periodic>
   [[gnu::always_inline]] inline bool integrate_particles(std::size_t begin, std::size_t end);
-  __attribute__((target("avx2"))) bool integrate_particles_avx2(std::size_t begin,
-                                                                std::size_t end) requires(D == 2);
+  __attribute__((target("avx2"))) bool integrate_particles_avx2(std::size_t begin, std::size_t end);
   void advance_walls();
 
   /// Puts every per-particle array in the new order: `previous[k]` is the index before of the
