@@ -2,7 +2,9 @@
 // candidate keeps the lifters it may touch, made at each neighbour-list rebuild and again when
 // the mill has turned the lifters by the smallest radius, and each step tests those alone. It
 // is a shortcut, never a change to the physics: the same contacts must be found in the same
-// order, so the motion is the same to the last bit.
+// order, so the motion is the same to the last bit. (So is the wall stage's other shortcut,
+// which the lists make possible: a candidate with no lifter near, clear of the shell and the
+// end plates, is passed over without a search; evaluate_wall_block.)
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -847,6 +847,31 @@ void World<D>::finish_wall_stage() {
 }
 
 template <int D>
+bool World<D>::mill_has_cones() const {
+  if constexpr (D == 3) {
+    return walls_.mill && walls_.mill->has_cones();
+  } else {
+    return false;
+  }
+}
+
+template <int D>
+bool World<D>::clear_of_shell_and_ends(std::uint32_t i, double shell_radius) const {
+  const Vec<D>& x = particles_.position[i];
+  const double r = particles_.radius[i];
+  // Clear of the shell with a margin far beyond rounding, so that mill_contacts, which tests
+  // norm(x) + r > R, finds no contact in any case this passes.
+  const double clear = shell_radius - r - 1e-9 * shell_radius;
+  if (!(clear > 0.0 && x[0] * x[0] + x[1] * x[1] < clear * clear)) return false;
+  if constexpr (D == 3) {
+    // mill_contacts' own test of the flat end plates.
+    const auto& mill = *walls_.mill;
+    if (!mill.periodic && (x[2] < r || mill.length - x[2] < r)) return false;
+  }
+  return true;
+}
+
+template <int D>
 void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
   const double dt = settings_.time_step;
   const std::size_t candidates = wall_candidates_.size();
@@ -867,9 +892,21 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
   const std::size_t most = walls_.max_contacts();
   std::size_t found = 0;
   first_work.assign(end - begin + 1, 0);
+  // Most candidates are near no wall this step: a lifter may sweep past them later, but none
+  // is near now (their list of nearby lifters is empty) and they are clear of the shell and
+  // the end plates. Told apart here with no search and no call (in the 3D 20 k scene, nine
+  // candidates in ten).
+  const bool quick =
+      !nearby_lifters_.empty() && walls_.planes.empty() && walls_.mill && !mill_has_cones();
+  const double shell_radius = walls_.mill ? walls_.mill->radius : 0.0;
   for (std::size_t k = begin; k < end; ++k) {
     const std::uint32_t i = wall_candidates_[k];
     std::int32_t* slot_id = &wall_slot_id_[k * max_wall_contacts];
+    if (quick && nearby_lifters_[k].count == 0 && clear_of_shell_and_ends(i, shell_radius) &&
+        std::all_of(slot_id, slot_id + max_wall_contacts, [](std::int32_t id) { return id < 0; })) {
+      first_work[k - begin + 1] = static_cast<std::uint32_t>(found);
+      continue;
+    }
     WallHistory* slot_history = &wall_slot_history_[k * max_wall_contacts];
     unsigned seen = 0;  // bit s: slot s touched now
     const NearbyLifters* nearby = nearby_lifters_.empty() ? nullptr : &nearby_lifters_[k];

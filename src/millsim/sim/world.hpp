@@ -328,6 +328,11 @@ class World {
 #endif
   [[gnu::always_inline]] inline void evaluate_wall_laws_in_lanes(const WallContact<D>* contact,
                                                                  WallWork* work, std::size_t count);
+  /// Whether the mill has conical ends (never in 2D).
+  bool mill_has_cones() const;
+  /// Whether particle i is surely clear of the shell of radius shell_radius and, in a 3D
+  /// mill with flat ends, of the end plates (a wall-stage shortcut: evaluate_wall_block).
+  bool clear_of_shell_and_ends(std::uint32_t i, double shell_radius) const;
   void refresh_nearby_lifters();
   bool lifters_moved_too_far() const;
   void evaluate_wall_contacts();
