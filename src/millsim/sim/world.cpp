@@ -1111,10 +1111,10 @@ bool World<D>::accumulate_forces_and_integrate() {
 
 template <int D>
 bool World<D>::integrate_run(std::size_t begin, std::size_t end) {
-  if (neighbours_.period() > 0.0) return integrate_particles<true>(begin, end);
 #if defined(__x86_64__)
   if (avx2_lanes_) return integrate_particles_avx2(begin, end);
 #endif
+  if (neighbours_.period() > 0.0) return integrate_particles<true>(begin, end);
   return integrate_particles<false>(begin, end);
 }
 
@@ -1422,12 +1422,12 @@ struct FourVectors {
 template <int D>
 bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
   if constexpr (D == 2) {
-    return integrate_particles<false>(begin, end);
+    return integrate_particles<false>(begin, end);  // (a 2D world is never periodic)
   } else {
-    // integrate_particles<false> four spheres at a time: their vectors are three registers,
-    // each operation the one the scalar loop does on each component (the per-sphere factors
-    // spread over the components), so the bits are the same. The scalar loop, one sphere at a
-    // time through SSE2 halves, was bound by its instructions (about ninety a sphere).
+    // integrate_particles four spheres at a time: their vectors are three registers, each
+    // operation the one the scalar loop does on each component (the per-sphere factors spread
+    // over the components), so the bits are the same. The scalar loop, one sphere at a time
+    // through SSE2 halves, was bound by its instructions (about ninety a sphere).
     auto& p = particles_;
     Vec3* const force = p.force.data();
     const Vec3* const torque = p.torque.data();
@@ -1446,10 +1446,20 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
                                Lanes{g[2], g[0], g[1], g[2]}}};
     const Lanes dt = splat<Lanes>(settings_.time_step);
     const Lanes half_step = splat<Lanes>(0.5 * settings_.time_step);
+    // A periodic slab: each sphere's z (lane 2, 1, and 0 and 3 of the three registers) kept in
+    // [0, period) as the scalar loop keeps it.
+    const double period = neighbours_.period();
+    const bool periodic = period > 0.0;
+    const Lanes period_lanes = splat<Lanes>(period);
+    const Lanes crossed_lanes = splat<Lanes>(0.49 * period);
+    const std::array<Mask<Lanes>, 3> axial{{Lanes{0.0, 0.0, 1.0, 0.0} > 0.0,
+                                            Lanes{0.0, 1.0, 0.0, 0.0} > 0.0,
+                                            Lanes{1.0, 0.0, 0.0, 1.0} > 0.0}};
     constexpr std::size_t prefetch_distance = 12;
     const bool prefetch = prefetch_pairs_;
     const std::size_t last = p.size() - 1;
     Mask<Lanes> moved{};
+    bool moved_one_by_one = false;
     std::size_t i = begin;
     for (; i + 4 <= end; i += 4) {
       if (prefetch) {
@@ -1477,7 +1487,14 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
       // u̇ += (m⁻¹ Δt) F, u += Δt u̇, ω += (I⁻¹ Δt) M
       const FourVectors v = add_scaled(load_vectors(&velocity[i]), spread(im * dt), f);
       store_vectors(&velocity[i], v);
-      const FourVectors x = add_scaled(load_vectors(&position[i]), spread(dt), v);
+      FourVectors x = add_scaled(load_vectors(&position[i]), spread(dt), v);
+      if (periodic) {
+        for (int k = 0; k < 3; ++k) {
+          Lanes& z = x.part[k];
+          z = select(axial[k] & (z < 0.0), z + period_lanes, z);
+          z = select(axial[k] & (z >= period_lanes), z - period_lanes, z);
+        }
+      }
       store_vectors(&position[i], x);
       const FourVectors w = add_scaled(load_vectors(&spin[i]), spread(ii * dt), t);
       store_vectors(&spin[i], w);
@@ -1486,9 +1503,22 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
       store_vectors(&spin_now[i], add_scaled(w, spread(half_step * ii), t));
       // Moved half a skin: each sphere's (dx² + dy²) + dz², as norm_squared sums them.
       const FourVectors r = load_vectors(&reference[i]);
-      const Lanes q0 = (x.part[0] - r.part[0]) * (x.part[0] - r.part[0]);
-      const Lanes q1 = (x.part[1] - r.part[1]) * (x.part[1] - r.part[1]);
-      const Lanes q2 = (x.part[2] - r.part[2]) * (x.part[2] - r.part[2]);
+      const Lanes d0 = x.part[0] - r.part[0];
+      const Lanes d1 = x.part[1] - r.part[1];
+      const Lanes d2 = x.part[2] - r.part[2];
+      if (periodic && any((axial[0] & (lane_abs(d0) >= crossed_lanes)) |
+                          (axial[1] & (lane_abs(d1) >= crossed_lanes)) |
+                          (axial[2] & (lane_abs(d2) >= crossed_lanes)))) {
+        // A sphere has crossed an end since the list was made (rare): the nearest image's
+        // offset, one by one, as NeighbourList::displacement takes it.
+        for (std::size_t s = i; s < i + 4; ++s) {
+          moved_one_by_one = moved_one_by_one || neighbours_.moved_too_far(s, position[s]);
+        }
+        continue;
+      }
+      const Lanes q0 = d0 * d0;
+      const Lanes q1 = d1 * d1;
+      const Lanes q2 = d2 * d2;
       // q0 = x0 y0 z0 x1, q1 = y1 z1 x2 y2, q2 = z2 x3 y3 z3 (squares).
       const Lanes xy01 = __builtin_shufflevector(q0, q1, 0, 3, 6, 1);  // x0 x1 x2 y0
       const Lanes xs = __builtin_shufflevector(xy01, q2, 0, 1, 2, 5);  // x0 x1 x2 x3
@@ -1498,8 +1528,12 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
       const Lanes zs = __builtin_shufflevector(zs01, q2, 0, 1, 4, 7);  // z0 z1 z2 z3
       moved |= (xs + ys) + zs > limit;
     }
-    bool any_moved = any(moved);
-    if (i < end) any_moved = integrate_particles<false>(i, end) || any_moved;
+    bool any_moved = any(moved) || moved_one_by_one;
+    if (i < end) {
+      any_moved =
+          (periodic ? integrate_particles<true>(i, end) : integrate_particles<false>(i, end)) ||
+          any_moved;
+    }
     return any_moved;
   }
 }
