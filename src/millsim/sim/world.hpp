@@ -353,10 +353,10 @@ class World {
   bool accumulate_forces_and_integrate();
   /// Particles [begin, end) advanced by the loop for this world (integrate_particles).
   bool integrate_run(std::size_t begin, std::size_t end);
-  /// Its loop over particles [begin, end), for a periodic slab or not. The one without a period
-  /// has a second version for processors with AVX2, the same bits either way: in 2D the same
-  /// loop compiled again (two discs in a register, where the other works on one), in 3D four
-  /// spheres at a time (integrate_spheres_avx2).
+  /// Its loop over particles [begin, end), for a periodic slab or not. Processors with AVX2 run
+  /// a second version, the same bits either way (integrate_particles_avx2): in 2D the loop
+  /// without a period compiled again (two discs in a register, where the other works on one),
+  /// in 3D four spheres at a time, periodic or not.
   template <bool periodic>
   [[gnu::always_inline]] inline bool integrate_particles(std::size_t begin, std::size_t end);
   __attribute__((target("avx2"))) bool integrate_particles_avx2(std::size_t begin, std::size_t end);
