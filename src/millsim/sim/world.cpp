@@ -69,12 +69,13 @@ bool splits_among_threads(std::size_t pairs, int threads) {
   return threads > 1 && pairs >= parallel_pair_threshold;
 }
 /// When the particle arrays that the pair kernel reads and writes hold more than this many
-/// bytes, several times a core's second-level cache, the kernel prefetches the particles and
+/// bytes, half a core's second-level cache here, the kernel prefetches the particles and
 /// history of the pairs two lanes ahead: the second particle of a pair is met out of order and
-/// comes from memory otherwise. Below it the prefetches cost more than they save
-/// (bench/results.md: +10 % on the 1e5-ball slab of the scaling series, −3 % on the 3D 20 k
-/// scene).
-constexpr std::size_t prefetch_threshold_bytes = std::size_t{8} << 20;
+/// comes from beyond that cache otherwise. Below it the prefetches cost more than they save
+/// (bench/results.md, sixteenth session: the 2D SAG scene, 0.6 MB, 5–7 % slower with them; the
+/// 1e4-ball slab, 1.5 MB, 2–4 % faster; the 3D 20 k scene and the LIGGGHTS comparison's, 3 MB,
+/// 3–8 % faster; the 1e5-ball slab, 15 MB, +10 % in the eleventh).
+constexpr std::size_t prefetch_threshold_bytes = std::size_t{1} << 20;
 
 /// Whether this processor has AVX2 (asked once).
 bool processor_has_avx2() {
