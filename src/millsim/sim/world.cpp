@@ -571,13 +571,96 @@ std::size_t World<D>::list_pairs_for_law(std::size_t begin, std::size_t end, std
   // Four loops, so that each pair costs only the instructions its world needs (the loop is
   // bound by their number: about 37 a pair, five a cycle, in the 3D 20 k scene before).
   const bool every_pair = below >= particles_.size();
+  std::size_t count = 0;
   if (neighbours_.period() > 0.0) {
-    return every_pair ? list_pairs_of<true, true>(begin, end, below, listed)
-                      : list_pairs_of<true, false>(begin, end, below, listed);
+    count = every_pair ? list_pairs_of<true, true>(begin, end, below, listed)
+                       : list_pairs_of<true, false>(begin, end, below, listed);
+#if defined(__x86_64__)
+  } else if (D == 3 && every_pair && avx2_lanes_) {
+    count = list_pairs_avx2(begin, end, listed);
+#endif
+  } else {
+    count = every_pair ? list_pairs_of<false, true>(begin, end, below, listed)
+                       : list_pairs_of<false, false>(begin, end, below, listed);
   }
-  return every_pair ? list_pairs_of<false, true>(begin, end, below, listed)
-                    : list_pairs_of<false, false>(begin, end, below, listed);
+  // The kernel takes them lane_count at a time: the last group is filled up with copies of the
+  // last pair (evaluate_listed_pairs_in_lanes).
+  for (std::size_t l = count; count > 0 && l % lane_count != 0; ++l) listed[l] = listed[count - 1];
+  return count;
 }
+
+#if defined(__x86_64__)
+namespace {
+
+/// Four pair numbers in one register.
+using FourIndices = std::uint32_t __attribute__((vector_size(4 * sizeof(std::uint32_t))));
+
+/// For each set of four lanes (bit l for lane l): the kept lanes in order, and how many.
+struct KeptLanes {
+  std::array<std::uint32_t, 4> lanes;
+  std::uint32_t count;
+};
+constexpr std::array<KeptLanes, 16> kept_lanes_table() {
+  std::array<KeptLanes, 16> table{};
+  for (unsigned set = 0; set < 16; ++set) {
+    std::uint32_t count = 0;
+    for (std::uint32_t l = 0; l < 4; ++l) {
+      if ((set >> l) & 1U) table[set].lanes[count++] = l;
+    }
+    table[set].count = count;
+  }
+  return table;
+}
+constexpr std::array<KeptLanes, 16> kept_lanes = kept_lanes_table();
+
+}  // namespace
+
+template <int D>
+std::size_t World<D>::list_pairs_avx2(std::size_t begin, std::size_t end,
+                                      std::uint32_t* listed) const {
+  if constexpr (D != 3) {
+    return list_pairs_of<false, true>(begin, end, end, listed);
+  } else {
+    constexpr auto lanes = static_cast<std::size_t>(lane_count);
+    const auto& first = neighbours_.first();
+    const auto& second = neighbours_.second();
+    const auto& x = particles_.position;
+    const auto& r = particles_.radius;
+    const TouchState* touching = neighbours_.touching().data();
+    static_assert(static_cast<std::uint8_t>(TouchState::apart) == 0 &&
+                  static_cast<std::uint8_t>(TouchState::touching) == 1);
+    std::size_t count = 0;
+    std::size_t q = begin;
+    for (; q + lanes <= end; q += lanes) {
+      std::array<std::uint32_t, lanes> i{}, j{};
+      for (std::size_t l = 0; l < lanes; ++l) {
+        i[l] = first[q + l];
+        j[l] = second[q + l];
+      }
+      // The operations of list_pairs_of, in the same order, each lane a pair.
+      const Vec<2, Lanes> planar = lanes_of(
+          [&](std::size_t l) { return planar_pair_of(x[j[l]]) - planar_pair_of(x[i[l]]); });
+      const Lanes dz = gather_lanes([&](std::size_t l) { return x[j[l]][2] - x[i[l]][2]; });
+      const Lanes reach = gather_lanes([&](std::size_t l) { return r[i[l]] + r[j[l]]; });
+      const Lanes distance_squared = (planar[0] * planar[0] + planar[1] * planar[1]) + dz * dz;
+      auto keep = static_cast<unsigned>(
+          __builtin_ia32_movmskpd256(reinterpret_cast<Lanes>(distance_squared < reach * reach)));
+      // The four pairs' touch states, one byte each (0 or 1), gathered into bits 24 to 27.
+      std::uint32_t states = 0;
+      std::memcpy(&states, touching + q, sizeof states);
+      keep |= ((states * 0x01020408U) >> 24) & 0xFU;
+      // The kept pairs' numbers written at once, in order; the rest of the four is overwritten
+      // by the next ones (or repeats, or is left beyond the count).
+      FourIndices numbers{};
+      std::memcpy(&numbers, kept_lanes[keep].lanes.data(), sizeof numbers);
+      numbers += static_cast<std::uint32_t>(q);
+      std::memcpy(listed + count, &numbers, sizeof numbers);
+      count += kept_lanes[keep].count;
+    }
+    return count + list_pairs_of<false, true>(q, end, end, listed + count);
+  }
+}
+#endif
 
 template <int D>
 template <bool periodic, bool every_pair>
@@ -618,9 +701,6 @@ std::size_t World<D>::list_pairs_of(std::size_t begin, std::size_t end, std::siz
     listed[count] = static_cast<std::uint32_t>(q);
     count += keep;
   }
-  // The kernel takes them lane_count at a time: the last group is filled up with copies of the
-  // last pair (evaluate_listed_pairs_in_lanes).
-  for (std::size_t l = count; count > 0 && l % lane_count != 0; ++l) listed[l] = listed[count - 1];
   return count;
 }
 
