@@ -569,7 +569,8 @@ template <int D>
 std::size_t World<D>::list_pairs_for_law(std::size_t begin, std::size_t end, std::size_t below,
                                          std::uint32_t* listed) const {
   // Four loops, so that each pair costs only the instructions its world needs (the loop is
-  // bound by their number: about 37 a pair, five a cycle, in the 3D 20 k scene before).
+  // bound by their number: about 37 a pair, five a cycle, in the 3D 20 k scene before), and in
+  // 3D with AVX2 a fifth that takes four pairs at a time.
   const bool every_pair = below >= particles_.size();
   std::size_t count = 0;
   if (neighbours_.period() > 0.0) {
