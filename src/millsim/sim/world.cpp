@@ -11,6 +11,7 @@
 #include <memory>
 #include <type_traits>
 
+#include "millsim/core/prefetch.hpp"
 #include "millsim/core/vector_growth.hpp"
 
 namespace millsim {
@@ -748,7 +749,7 @@ void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, st
   const auto& p = particles_;
   for (std::size_t k = begin; k < end; ++k) {
     const std::uint32_t q = listed[k];
-    __builtin_prefetch(&neighbours_.history()[q]);
+    prefetch_record(neighbours_.history()[q]);
     for (const std::uint32_t i : {neighbours_.first()[q], neighbours_.second()[q]}) {
       __builtin_prefetch(&velocity_now_[i]);
       __builtin_prefetch(&spin_now_[i]);
@@ -1026,6 +1027,9 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
         slot_id[slot] = wall_id;
       }
       seen |= 1U << static_cast<unsigned>(slot);
+      // The slot's history, which the law reads and writes once the block's contacts are found:
+      // in a large world it is in memory, one slot here and there.
+      if (prefetch_pairs_) prefetch_record(slot_history[slot], true);
       if (kept_count != c) contact[kept_count] = contact[c];
       WallWork& work_of = work_list[found + static_cast<std::size_t>(kept_count)];
       work_of.particle = i;
