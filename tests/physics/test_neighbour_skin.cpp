@@ -33,21 +33,21 @@ World<2> two_discs_after_one_step(double speed, double fixed_skin = 0.0) {
 }
 
 TEST(NeighbourSkin, ChosenToLastTheTargetStepsAtTheFastestParticlesSpeed) {
-  // 2 × 30 steps × 1e-5 s × 5 m/s = 3 mm, between 0.05 and 3 of the smallest radius (1 cm).
+  // 2 × 45 steps × 1e-5 s × 5 m/s = 4.5 mm, between 0.05 and 3 of the smallest radius (1 cm).
   const World<2> world = two_discs_after_one_step(5.0);
   EXPECT_DOUBLE_EQ(world.neighbour_skin(), 2.0 * skin_target_steps * time_step * 5.0);
-  EXPECT_DOUBLE_EQ(world.neighbour_skin(), 0.003);
+  EXPECT_DOUBLE_EQ(world.neighbour_skin(), 0.0045);
 }
 
 TEST(NeighbourSkin, StillParticlesGetTheFloorAndFastOnesTheCeiling) {
   EXPECT_DOUBLE_EQ(two_discs_after_one_step(0.0).neighbour_skin(), skin_floor * radius);
-  // 2 × 30 × 1e-5 s × 100 m/s = 6 cm would exceed three times the smallest radius (1 cm):
+  // 2 × 45 × 1e-5 s × 100 m/s = 9 cm would exceed three times the smallest radius (1 cm):
   // capped there.
   EXPECT_DOUBLE_EQ(two_discs_after_one_step(100.0).neighbour_skin(), skin_ceiling<2> * radius);
 }
 
 TEST(NeighbourSkin, TheCeilingIsThreeRadiiIn2DAndOneIn3D) {
-  // The same fast particle (6 cm of skin wanted) in 3D is capped at one smallest radius.
+  // The same fast particle (9 cm of skin wanted) in 3D is capped at one smallest radius.
   WorldSettings<3> settings;
   settings.time_step = time_step;
   World<3> world(settings, Walls<3>{});
