@@ -677,7 +677,15 @@ std::size_t World<D>::list_pairs_of(std::size_t begin, std::size_t end, std::siz
   // without a branch (a third of the 2D SAG scene's listed pairs touch, scattered among the
   // others, which the processor could only mispredict).
   std::size_t count = 0;
+  // In a large world (prefetch_pairs_) the second particle's position, 64 pairs ahead: this
+  // pass is the step's first to read it, out of memory order and, beyond the caches, from
+  // memory (the 1e6-ball slab: +2.5 to 4 %; 16 pairs ahead gained half that, the radius too
+  // lost it all).
+  constexpr std::size_t position_ahead = 64;
+  const bool prefetch = prefetch_pairs_;
+  const std::size_t pairs = second.size();
   for (std::size_t q = begin; q < end; ++q) {
+    if (prefetch && q + position_ahead < pairs) __builtin_prefetch(&x[second[q + position_ahead]]);
     const std::uint32_t i = first[q];
     const std::uint32_t j = second[q];
     double distance_squared = 0.0;
