@@ -18,9 +18,10 @@
 # Prints one row per point (particles, steps, wall and CPU seconds, particle-steps per wall and
 # per CPU second, bytes per particle: resident growth and the array estimate, neighbour-list
 # rebuilds), then the ratio of the slowest to the fastest rate of the ordered series. CPU time
-# is the figure to read on a shared machine. About 10 minutes of CPU time on one thread;
-# 1.0 GB of resident growth at the largest point (1003 B per ball at f300219, 1030 B at b13b5d1, 1199 B at
-# a6911f1, 1.84 GB before 5635d51).
+# is the figure to read on a shared machine. About a minute on one thread (once the base slab is
+# saved); 1.1 GB of resident growth at the largest point (1068 B per ball at d9cbdac, 972 B before
+# the skin's 45 steps of cf7bec7, 1003 B at f300219, 1030 B at b13b5d1, 1199 B at a6911f1, 1.84 GB
+# before 5635d51).
 #
 #   bench/run_scaling_series.sh [THREADS]          (default: 1 thread)
 #
