@@ -129,7 +129,7 @@ fi
 # --- power -------------------------------------------------------------------------------------
 source_dir=${MILLSIM_SOURCE:-.}
 driver="$work/millsim_power_window"
-g++ -std=c++20 -O3 -DNDEBUG -fno-math-errno -fopenmp -DFMT_SHARED -DTOML_HEADER_ONLY=0 \
+g++ -std=c++20 -O3 -DNDEBUG -fno-math-errno -Wno-psabi -fopenmp -DFMT_SHARED -DTOML_HEADER_ONLY=0 \
   -DTOML_SHARED_LIB=1 -I"$source_dir/src" -I"$build/generated" \
   bench/liggghts/millsim_power_window.cpp "$build/libmillsim_core.a" -ltomlplusplus -lfmt \
   -o "$driver"
