@@ -470,8 +470,9 @@ class World {
   // nearby_lifter_angle_ (refresh_nearby_lifters).
   bool nearby_lifter_lists_ = true;
   bool avx2_lanes_ = false;
-  /// Whether the pair kernel prefetches (prefetch_pairs): set at each rebuild from the number
-  /// of particles.
+  /// Whether the step prefetches what it will read out of memory order (the pair kernel's
+  /// prefetch_pairs, the one-pair-at-a-time first pass, the wall slots' histories, the 3D
+  /// integration): set at each rebuild from the size of the particle arrays (above 1 MiB).
   bool prefetch_pairs_ = false;
   std::vector<NearbyLifters> nearby_lifters_;
   double nearby_lifter_angle_ = 0.0;
