@@ -125,6 +125,25 @@ TEST(Config, ReadsTheBaseConfig) {
   EXPECT_EQ(c.measure_revolutions, 4);
 }
 
+TEST(Config, MaterialsDefaultToSteelWithTheTangentialStiffnessTwoThirdsOfTheNormal) {
+  // MODEL.md §3: k_s defaults to 2/3 k_n, of the k_n given or of the default 4e5 N/m.
+  const MillConfig defaults = parse_mill_config(base_config, file_name);
+  EXPECT_EQ(defaults.ball_ball.normal_stiffness, 4.0e5);
+  EXPECT_DOUBLE_EQ(defaults.ball_ball.tangential_stiffness, 4.0e5 * 2.0 / 3.0);
+  EXPECT_DOUBLE_EQ(defaults.ball_wall.tangential_stiffness, 4.0e5 * 2.0 / 3.0);
+  EXPECT_EQ(defaults.ball_ball.restitution, 0.6);
+  EXPECT_EQ(defaults.ball_ball.friction, 0.5);
+
+  const MillConfig given = parse_mill_config(
+      std::string(base_config) + "[materials.ball_ball]\nnormal_stiffness = 9.0e5\n\n" +
+          "[materials.ball_wall]\nnormal_stiffness = 6.0e5\ntangential_stiffness = 5.5e5\n",
+      file_name);
+  EXPECT_EQ(given.ball_ball.normal_stiffness, 9.0e5);
+  EXPECT_DOUBLE_EQ(given.ball_ball.tangential_stiffness, 6.0e5);
+  EXPECT_EQ(given.ball_wall.normal_stiffness, 6.0e5);
+  EXPECT_EQ(given.ball_wall.tangential_stiffness, 5.5e5);
+}
+
 TEST(Config, ReadsTheShippedExample) {
   const std::string path = std::string(MILLSIM_SOURCE_DIR) + "/examples/lab-mill-2d.toml";
   const MillConfig c = load_mill_config(path);

@@ -313,8 +313,10 @@ ContactMaterial read_material(TableReader section) {
   ContactMaterial m;
   m.normal_stiffness =
       section.number("normal_stiffness", m.normal_stiffness, "a number of N/m > 0", positive);
-  m.tangential_stiffness = section.number("tangential_stiffness", m.tangential_stiffness,
-                                          "a number of N/m > 0", positive);
+  // MODEL.md §3's default: 2/3 of the normal stiffness, whichever that is.
+  m.tangential_stiffness =
+      section.number("tangential_stiffness", default_tangential_share * m.normal_stiffness,
+                     "a number of N/m > 0", positive);
   m.restitution = section.number("restitution", m.restitution, "a number > 0 and <= 1",
                                  [](double e) { return e > 0.0 && e <= 1.0; });
   m.friction = section.number("friction", m.friction, "a number >= 0 and <= 10",

@@ -4,12 +4,17 @@
 
 namespace millsim {
 
+/// k_s / k_n when a config gives no tangential stiffness (MODEL.md §3).
+inline constexpr double default_tangential_share = 2.0 / 3.0;
+
 /// What the user gives for one material pair (ball–ball, ball–wall). SI units.
 struct ContactMaterial {
-  double normal_stiffness = 4.0e5;      ///< k_n, N/m
-  double tangential_stiffness = 3.0e5;  ///< k_s, N/m
-  double restitution = 0.6;             ///< e, in (0, 1]
-  double friction = 0.5;                ///< μ, >= 0
+  double normal_stiffness = 4.0e5;  ///< k_n, N/m
+  /// k_s, N/m; by default 2/3 of k_n (MODEL.md §3: Hertzian theory puts it between 2/3 and 1
+  /// of k_n for Poisson's ratios below 0.5).
+  double tangential_stiffness = default_tangential_share * 4.0e5;
+  double restitution = 0.6;  ///< e, in (0, 1]
+  double friction = 0.5;     ///< μ, >= 0
 };
 
 /// Damping ratio ζ of the linear spring–dashpot that gives restitution e (Corkum's relation):
