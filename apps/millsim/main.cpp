@@ -159,8 +159,10 @@ int run_command(const JobOptions& options) {
   const MillResult result = run_job(config, !options.quiet);
   fmt::print("{}\n", millsim::summary_line(result));
   if (!options.quiet) {
-    fmt::print("results in {}/ (summary.json, power.csv, power_timeseries.csv, spectrum.csv)\n",
-               config.output_directory);
+    fmt::print(
+        "results in {}/ (summary.json, power.csv, power_timeseries.csv, spectrum.csv, "
+        "charge_profile.csv)\n",
+        config.output_directory);
   }
   return 0;
 }

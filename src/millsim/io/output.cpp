@@ -38,6 +38,18 @@ std::string power_table(const std::vector<PowerInterval>& rows, bool numbered) {
   return text;
 }
 
+/// The liner layer's mean ball count by angle (ChargeProfile), one row a bin.
+std::string charge_profile_table(const MillResult& result) {
+  std::string text = "angle_low_rad,angle_high_rad,liner_layer_balls\n";
+  if (!result.charge_profile) return text;
+  const ChargeProfile& profile = *result.charge_profile;
+  for (int k = 0; k < ChargeProfile::bins; ++k) {
+    text += fmt::format("{:.6f},{:.6f},{:.6g}\n", k * ChargeProfile::bin_width,
+                        (k + 1) * ChargeProfile::bin_width, profile.mean_count(k));
+  }
+  return text;
+}
+
 std::string spectrum_table(const MillResult& result) {
   const ImpactSpectrum& s = result.spectrum;
   const double window = result.window_end.time - result.window_start.time;
@@ -141,6 +153,13 @@ std::vector<SummaryNumber> summary_numbers(const MillResult& r) {
       {"charge_orbital_speed_ratio", r.orbital_speed_ratio},
       {"dimension", count(c.dimension), true},
   };
+  // Only where the charge has a toe and a shoulder (not when it lines the whole shell).
+  if (r.charge_profile) {
+    if (const auto ends = r.charge_profile->toe_and_shoulder()) {
+      numbers.push_back({"charge_toe_angle_rad", ends->toe});
+      numbers.push_back({"charge_shoulder_angle_rad", ends->shoulder});
+    }
+  }
   append_empirical_numbers(numbers, empirical_power(plan));
   if (c.reference) {
     numbers.push_back({"reference.measured_power_kw", c.reference->measured_kw});
@@ -249,6 +268,7 @@ void write_results(const std::filesystem::path& directory, const MillResult& res
   write_file(directory / "power.csv", power_table(result.revolutions, true));
   write_file(directory / "power_timeseries.csv", power_table(result.series, false));
   write_file(directory / "spectrum.csv", spectrum_table(result));
+  write_file(directory / "charge_profile.csv", charge_profile_table(result));
   write_file(directory / "summary.json", summary_json(result));
 }
 

@@ -110,6 +110,9 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
       measuring = true;
       result.window_start = sample(world);
       world.record_collisions_in(&result.spectrum);
+      const MillConfig& c = plan.config;
+      result.charge_profile.emplace(plan.radius, c.lifter_count > 0 ? c.lifter_height : 0.0,
+                                    plan.angular_speed >= 0.0);
     }
     if (turned >= full_angle) break;
     const double since = world.time() - rotation_start;
@@ -126,6 +129,7 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
         const auto [centre, angular_speed] = charge_motion(world);
         result.charge_centre += centre;
         result.orbital_speed_ratio += angular_speed / plan.angular_speed;
+        result.charge_profile->add(world.particles().position, world.particles().radius);
         ++motion_samples;
       }
       series_start = now;

@@ -3,8 +3,10 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <vector>
 
+#include "millsim/measure/charge_profile.hpp"
 #include "millsim/measure/spectrum.hpp"
 #include "millsim/sim/charge.hpp"
 
@@ -55,6 +57,9 @@ struct MillResult {
   /// Mean over the window and the balls of their angular speed about the mill axis divided by
   /// the shell's: 1 when the charge rides with the shell (centrifuged).
   double orbital_speed_ratio = 0.0;
+  /// The liner layer's balls by angle over the measured window, and from them the charge's toe
+  /// and shoulder (ChargeProfile; sampled 50 times a revolution, with the charge's centre).
+  std::optional<ChargeProfile> charge_profile;
 };
 
 /// Called now and then with (simulated time, total time, revolutions so far).
