@@ -374,7 +374,9 @@ TEST(Config, RefusesMoreMeasuredRevolutionsThanRun) {
                                   "simulation.measure_revolutions", "default 4", "from 1 to 2"});
   expect_has(error_of(base_config, {"simulation.revolutions=0.5"}),
              {"command line (--set simulation.revolutions=0.5)", "simulation.revolutions",
-              "allowed: a number of revolutions >= 1"});
+              "allowed: a whole number of revolutions from 1"});
+  expect_has(error_of(base_config, {"simulation.revolutions=1.5"}),
+             {"simulation.revolutions", "1.5 is not a whole number"});
 }
 
 TEST(Config, AValidOverrideChangesTheValueAndIsRecordedAsFromTheCommandLine) {

@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "millsim/builtin_example.hpp"
@@ -174,6 +176,56 @@ TEST(MillPlan, GivenTimeStepIsUsedBelowTheStabilityLimitAndRefusedAboveIt) {
   EXPECT_HAND(plan.critical_time_step, 1.0907769e-3);
   EXPECT_EQ(plan_mill(lab_mill({"simulation.time_step=1e-3"})).time_step, 1e-3);
   EXPECT_THROW(plan_mill(lab_mill({"simulation.time_step=1.1e-3"})), InputError);
+}
+
+TEST(MillPlan, AutoTimeStepStaysAtAQuarterOfTheStabilityLimitWhenTheTangentialSpringIsStiff) {
+  // k_s = 1e9 N/m: the tangential ω = sqrt(6 k_s/m) = sqrt(6e9/0.53540739) = 1.0586038e5 s⁻¹,
+  // limit 2/ω = 1.8892810e-5 s, far below t_c/20 = 1.3019180e-4 s: the step is a quarter of it,
+  // 4.7232024e-6 s.
+  const MillPlan plan = plan_mill(lab_mill({"materials.ball_ball.tangential_stiffness=1e9",
+                                            "materials.ball_wall.tangential_stiffness=1e9"}));
+  EXPECT_HAND(plan.critical_time_step, 1.8892810e-5);
+  EXPECT_HAND(plan.time_step, 4.7232024e-6);
+  EXPECT_EQ(plan.time_step, 0.25 * plan.critical_time_step);
+}
+
+/// The message of the InputError plan_mill throws for `config`.
+std::string plan_error(const MillConfig& config) {
+  try {
+    plan_mill(config);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "planned";
+  return {};
+}
+
+void expect_has(const std::string& message, std::initializer_list<std::string_view> parts) {
+  for (const std::string_view part : parts) {
+    EXPECT_NE(message.find(part), std::string::npos) << "lacks \"" << part << "\":\n" << message;
+  }
+}
+
+TEST(MillPlan, RefusesMillsThatCannotRunNamingTheKey) {
+  // Critical speed 45.900339 rpm (above): at most 5 times that, 229.5 rpm.
+  MillConfig in_rpm = lab_mill();
+  in_rpm.speed_fraction.reset();
+  in_rpm.speed_rpm = 1e6;
+  expect_has(plan_error(in_rpm), {"mill.speed_rpm", "at most 5 times critical, 229.5 rpm"});
+  // A 1 km mill 30 % full of 5.08 cm discs at a 2D void fraction of 0.2:
+  // 0.3 × π 500² × 0.8 / (π/4 × 0.0508²) = 9.3e7 discs.
+  expect_has(plan_error(lab_mill({"mill.diameter=1000"})),
+             {"charge.filling", "9.3e+07 discs", "at most 5e+07"});
+  // 1e-9 of the volume: 75 discs at J = 0.3 become 2.5e-7 of one.
+  expect_has(plan_error(lab_mill({"charge.filling=1e-9"})), {"charge.filling", "rounds to none"});
+  // 1 s of settling and 6 revolutions of 60/22.950170 = 2.6143604 s: 16.686 s, at 1e-9 s a step
+  // 1.67e10 steps.
+  expect_has(plan_error(lab_mill({"simulation.time_step=1e-9"})),
+             {"simulation.revolutions", "1.67e+10 steps", "at most 1e+10 steps"});
+  MillConfig snapshots = lab_mill();
+  snapshots.snapshot_interval = 1e-5;
+  expect_has(plan_error(snapshots),
+             {"output.snapshot_interval", "shorter than the time step, 0.0001302 s"});
 }
 
 /// Every disc inside the shell, clear of the lifters and of every other disc.

@@ -87,9 +87,10 @@ void read_simulation(TableReader section, MillConfig& config) {
   config.settle_time = section.number("settle_time", 1.0, "a number of seconds >= 0, at most 1e4",
                                       [](double t) { return t >= 0.0 && t <= 1e4; });
   // At least one revolution: measure_revolutions (a whole number >= 1) are measured of them.
-  config.revolutions =
-      section.number("revolutions", 6.0, "a number of revolutions >= 1, at most 1e5",
-                     [](double n) { return n >= 1.0 && n <= 1e5; });
+  // Whole revolutions, so that the measured ones are the whole revolutions of power.csv.
+  config.revolutions = static_cast<double>(
+      section.integer("revolutions", 6, "a whole number of revolutions from 1 to 100000",
+                      [](long n) { return n >= 1 && n <= 100000; }));
   const long most = static_cast<long>(std::floor(config.revolutions));
   const std::string measure_rule =
       fmt::format("a whole number of revolutions from 1 to {} (simulation.revolutions)", most);
@@ -303,20 +304,25 @@ void read_charge(TableReader section, MillConfig& config) {
                      [](double j) { return j > 0.0 && j < 1.0; });
   config.porosity = section.number("porosity", 0.4, "a fraction >= 0 and < 1",
                                    [](double p) { return p >= 0.0 && p < 1.0; });
-  config.density = section.number("density", 7800.0, "a number of kg/m3 > 0", positive);
+  // Solids: from cork to the densest metals, with room either side.
+  config.density = section.number("density", 7800.0, "a number of kg/m3 from 10 to 1e5",
+                                  [](double rho) { return rho >= 10.0 && rho <= 1e5; });
   read_sizes(section, config);
 }
 
 ContactMaterial read_material(TableReader section) {
+  // Wide enough for any solid's contact, narrow enough that a contact lasts a finite time.
+  const std::string stiffness_rule = "a number of N/m from 1 to 1e12";
+  const auto stiffness_range = [](double k) { return k >= 1.0 && k <= 1e12; };
   section.allow_keys({"normal_stiffness", "tangential_stiffness", "restitution", "friction"},
                      belongs_elsewhere);
   ContactMaterial m;
   m.normal_stiffness =
-      section.number("normal_stiffness", m.normal_stiffness, "a number of N/m > 0", positive);
+      section.number("normal_stiffness", m.normal_stiffness, stiffness_rule, stiffness_range);
   // MODEL.md §3's default: 2/3 of the normal stiffness, whichever that is.
   m.tangential_stiffness =
       section.number("tangential_stiffness", default_tangential_share * m.normal_stiffness,
-                     "a number of N/m > 0", positive);
+                     stiffness_rule, stiffness_range);
   m.restitution = section.number("restitution", m.restitution, "a number > 0 and <= 1",
                                  [](double e) { return e > 0.0 && e <= 1.0; });
   m.friction = section.number("friction", m.friction, "a number >= 0 and <= 10",
@@ -506,7 +512,8 @@ SceneParticle read_scene_particle(TableReader p, int dimension) {
         read_vector(p, "angular_velocity", 3, "rad/s; default [0, 0, 0]", false);
   }
   particle.diameter = p.number("diameter", std::nullopt, "a number of metres > 0", positive);
-  particle.density = p.number("density", 7800.0, "a number of kg/m3 > 0 (default 7800)", positive);
+  particle.density = p.number("density", 7800.0, "a number of kg/m3 from 10 to 1e5 (default 7800)",
+                              [](double rho) { return rho >= 10.0 && rho <= 1e5; });
   const std::string material = p.string(
       "material", "ball",
       "\"ball\" (the particle material of [materials.ball_ball] and [materials.ball_wall])");

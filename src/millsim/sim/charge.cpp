@@ -13,6 +13,15 @@
 namespace millsim {
 namespace {
 
+/// The fastest mill: 5 times critical, as mill.speed allows.
+constexpr double most_speed_fraction = 5.0;
+/// The largest charge planned: 5e7 balls, about 55 GB at the 1.1 kB a ball the scaling
+/// benchmark measures (bench/results.md); far beyond it a count would also overflow an int.
+constexpr double most_particles = 5e7;
+/// The longest run: 1e10 steps, as for scenes (a thousand balls at 3e7 particle-steps a second
+/// would take four days).
+constexpr double most_steps = 1e10;
+
 double sphere_mass(double diameter, double density) {
   return density * pi / 6.0 * diameter * diameter * diameter;
 }
@@ -73,6 +82,14 @@ MillPlan plan_mill(const MillConfig& config) {
   } else {
     plan.speed_rpm = *config.speed_rpm;
     plan.speed_fraction = plan.speed_rpm / plan.critical_speed_rpm;
+    if (plan.speed_fraction > most_speed_fraction) {
+      throw InputError(fmt::format(
+          "{}: mill.speed_rpm: {} rpm is {:.3g} times this mill's critical speed, {:.4g} rpm; "
+          "allowed: > 0 and at most {} times critical, {:.4g} rpm (as for mill.speed)",
+          config.location_of("mill.speed_rpm"), plan.speed_rpm, plan.speed_fraction,
+          plan.critical_speed_rpm, most_speed_fraction,
+          most_speed_fraction * plan.critical_speed_rpm));
+    }
   }
   plan.angular_speed = plan.speed_rpm * 2.0 * pi / 60.0;
   plan.revolution_period = 60.0 / plan.speed_rpm;
@@ -104,6 +121,7 @@ MillPlan plan_mill(const MillConfig& config) {
     bed_volume += 2.0 * plan.cone_bed_volume;
   }
   plan.mill_charge_mass = config.density * (1.0 - config.porosity) * bed_volume;
+  std::vector<double> counts;  // of each size class, before rounding
   if (config.dimension == 2) {
     // Discs: the bed fills J of the slice with a 2D void fraction; each size class takes its
     // mass fraction of the disc area (a section through a 3D charge shows each size with its
@@ -111,9 +129,8 @@ MillPlan plan_mill(const MillConfig& config) {
     const double disc_area = config.filling * cross_section * (1.0 - disc_bed_porosity);
     for (const SizeClass& s : config.sizes) {
       const double one = pi / 4.0 * s.diameter * s.diameter;
-      plan.discs.push_back(
-          {s.diameter, sphere_mass(s.diameter, config.density),
-           std::max(1, static_cast<int>(std::lround(s.mass_fraction * disc_area / one)))});
+      counts.push_back(s.mass_fraction * disc_area / one);
+      plan.discs.push_back({s.diameter, sphere_mass(s.diameter, config.density), 0});
     }
   } else {
     // Spheres: the simulated length holds its share of the real charge, ρ (1 − porosity) J
@@ -122,10 +139,34 @@ MillPlan plan_mill(const MillConfig& config) {
     const double charge_mass = plan.mill_charge_mass * plan.simulated_length / config.length;
     for (const SizeClass& s : config.sizes) {
       const double one = sphere_mass(s.diameter, config.density);
-      plan.discs.push_back(
-          {s.diameter, one,
-           std::max(1, static_cast<int>(std::lround(s.mass_fraction * charge_mass / one)))});
+      counts.push_back(s.mass_fraction * charge_mass / one);
+      plan.discs.push_back({s.diameter, one, 0});
     }
+  }
+  // Counted in doubles and checked before they become whole numbers: a mill of kilometres or
+  // balls of microns would overflow them, or ask for more memory than any machine has.
+  double total = 0.0;
+  for (const double n : counts) total += n;
+  const std::string count_keys =
+      config.dimension == 2
+          ? "charge.filling, mill.diameter and the ball sizes"
+          : "charge.filling, mill.diameter, the simulated length and the ball sizes";
+  if (!(total <= most_particles)) {
+    throw InputError(fmt::format(
+        "{}: charge.filling: this charge is {:.3g} {}; allowed: at most {:.0e} (about {:.0f} GB "
+        "of memory), set by {}",
+        config.location_of("charge.filling"), total, config.dimension == 2 ? "discs" : "balls",
+        most_particles, most_particles * 1.1e3 / 1e9, count_keys));
+  }
+  if (!(total >= 0.5)) {
+    throw InputError(fmt::format(
+        "{}: charge.filling: this charge is {:.3g} of a {}, which rounds to none; allowed: a "
+        "filling, mill and ball sizes whose charge holds at least one (set by {})",
+        config.location_of("charge.filling"), total, config.dimension == 2 ? "disc" : "ball",
+        count_keys));
+  }
+  for (std::size_t k = 0; k < counts.size(); ++k) {
+    plan.discs[k].count = std::max(1, static_cast<int>(std::lround(counts[k])));
   }
   std::sort(plan.discs.begin(), plan.discs.end(),
             [](const DiscClass& a, const DiscClass& b) { return a.diameter > b.diameter; });
@@ -161,9 +202,35 @@ MillPlan plan_mill(const MillConfig& config) {
     }
     plan.time_step = *config.time_step;
   } else {
-    plan.time_step = accurate;
+    // 1/20 of the shortest contact, and never above a quarter of the stability limit: with a
+    // tangential stiffness far above the normal one the tangential oscillation is the faster.
+    plan.time_step = std::min(accurate, 0.25 * plan.critical_time_step);
+  }
+  if (!(std::isfinite(plan.time_step) && plan.time_step > 0.0)) {
+    // Only extreme stiffnesses and masses get here: the contact's frequency overflows.
+    throw InputError(fmt::format(
+        "{}: these materials and balls give no usable time step (shortest contact {:.3g} s, "
+        "stability limit {:.3g} s); allowed: stiffnesses (materials.*.normal_stiffness, "
+        "tangential_stiffness), a density and ball sizes whose contacts last a finite time",
+        config.source, std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall),
+        plan.critical_time_step));
   }
   plan.total_time = config.settle_time + config.revolutions * plan.revolution_period;
+  const double steps = plan.total_time / plan.time_step;
+  if (!(steps <= most_steps)) {
+    throw InputError(fmt::format(
+        "{}: simulation.revolutions: {} s of settling and {} revolutions of {:.4g} s at a time "
+        "step of {:.4g} s is {:.3g} steps; allowed: at most {:.0e} steps (fewer revolutions, a "
+        "shorter settle_time, a faster mill.speed, or a longer simulation.time_step)",
+        config.location_of("simulation.revolutions"), config.settle_time, config.revolutions,
+        plan.revolution_period, plan.time_step, steps, most_steps));
+  }
+  if (config.snapshot_interval > 0.0 && config.snapshot_interval < plan.time_step) {
+    throw InputError(fmt::format(
+        "{}: output.snapshot_interval: {} s is shorter than the time step, {:.4g} s; allowed: 0 "
+        "(no snapshots) or at least the time step",
+        config.location_of("output.snapshot_interval"), config.snapshot_interval, plan.time_step));
+  }
   return plan;
 }
 

@@ -192,21 +192,30 @@ ScenePlan plan_scene(const SceneConfig& config) {
     }
     plan.time_step = *config.time_step;
   } else {
-    plan.time_step = std::isfinite(shortest) ? shortest / steps_per_contact
-                                             : config.duration / steps_without_contacts;
+    // As for mills: 1/20 of the shortest contact, at most a quarter of the stability limit.
+    plan.time_step = std::isfinite(shortest)
+                         ? std::min(shortest / steps_per_contact, 0.25 * critical)
+                         : config.duration / steps_without_contacts;
+  }
+  if (!(std::isfinite(plan.time_step) && plan.time_step > 0.0)) {
+    throw InputError(fmt::format(
+        "{}: these particles and materials give no usable time step (shortest contact {:.3g} s, "
+        "stability limit {:.3g} s); allowed: stiffnesses, densities and diameters whose contacts "
+        "last a finite time",
+        config.source, shortest, critical));
   }
   const double exact = config.duration / plan.time_step;
-  const double whole = std::round(exact);
-  plan.steps =
-      static_cast<long>(std::abs(exact - whole) <= 1e-9 * exact ? whole : std::ceil(exact));
   constexpr double most_steps = 1e10;
-  if (static_cast<double>(plan.steps) > most_steps) {
+  if (!(exact <= most_steps)) {
     throw InputError(fmt::format(
         "{}: simulation.duration: {} s at a time step of {:.4g} s is {:.3g} steps; allowed: at "
         "most {:.0e} steps (shorten the duration or lengthen the time step)",
         config.location_of("simulation.duration"), config.duration, plan.time_step, exact,
         most_steps));
   }
+  const double whole = std::round(exact);
+  plan.steps =
+      static_cast<long>(std::abs(exact - whole) <= 1e-9 * exact ? whole : std::ceil(exact));
   if (config.trajectory_interval > 0.0) {
     plan.trajectory_every =
         std::max(1L, static_cast<long>(std::llround(config.trajectory_interval / plan.time_step)));
