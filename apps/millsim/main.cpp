@@ -9,6 +9,8 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <initializer_list>
+#include <new>
 #include <optional>
 #include <span>
 #include <string>
@@ -93,23 +95,50 @@ class ProgressLine {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
+/// Creates the output directory `out` and removes the `results` an earlier run left in it, so
+/// that a run stopped half-way leaves no mixture of two runs' files. `location` names where the
+/// directory was given (config line, --set or --out) for the message if it cannot be made.
+void prepare_output_directory(const std::filesystem::path& out, const std::string& location,
+                              std::initializer_list<const char*> results) {
+  if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
+    throw millsim::InputError(
+        fmt::format("{}: output.directory: \"{}\" exists and is not a directory; allowed: a "
+                    "directory path",
+                    location, out.string()));
+  }
+  try {
+    std::filesystem::create_directories(out);
+    for (const char* name : results) std::filesystem::remove(out / name);
+  } catch (const std::filesystem::filesystem_error& error) {
+    throw millsim::InputError(fmt::format(
+        "{}: output.directory: cannot make \"{}\" ({}); allowed: a directory that can be "
+        "created and written",
+        location, out.string(), error.code().message()));
+  }
+}
+
+/// Where the output directory was given: --out, or the config's key (or --set).
+template <typename Config>
+std::string output_location(const Config& config, const JobOptions& options) {
+  if (!options.output_directory.empty()) {
+    return fmt::format("command line (--out {})", options.output_directory);
+  }
+  return config.location_of("output.directory");
+}
+
 /// Plans, places the charge, and only then creates the output directory and runs, so that a
 /// config that cannot run writes nothing.
 template <int D>
-MillResult run_job(const MillPlan& plan, bool show_progress) {
+MillResult run_job(const MillPlan& plan, const std::string& out_location, bool show_progress) {
   const MillConfig& config = plan.config;
   millsim::World<D> world = millsim::build_mill_world<D>(plan);
   const std::filesystem::path out = config.output_directory;
-  if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
-    throw millsim::InputError(fmt::format(
-        "{}: output.directory: \"{}\" exists and is not a directory; allowed: a directory path",
-        config.location_of("output.directory"), config.output_directory));
-  }
-  std::filesystem::create_directories(out);
+  prepare_output_directory(
+      out, out_location,
+      {"summary.json", "power.csv", "power_timeseries.csv", "spectrum.csv", "charge_profile.csv"});
   const std::filesystem::path snapshots = out / "snapshots";
   std::filesystem::remove_all(snapshots);
   if (config.snapshot_interval > 0.0) std::filesystem::create_directories(snapshots);
-  std::filesystem::remove(out / "summary.json");
   ProgressLine progress(show_progress);
   MillResult result = millsim::run_mill(plan, std::move(world), snapshots, std::ref(progress));
   progress.clear();
@@ -117,9 +146,10 @@ MillResult run_job(const MillPlan& plan, bool show_progress) {
   return result;
 }
 
-MillResult run_job(const MillConfig& config, bool show_progress) {
+MillResult run_job(const MillConfig& config, const std::string& out_location, bool show_progress) {
   const MillPlan plan = millsim::plan_mill(config);
-  return config.dimension == 2 ? run_job<2>(plan, show_progress) : run_job<3>(plan, show_progress);
+  return config.dimension == 2 ? run_job<2>(plan, out_location, show_progress)
+                               : run_job<3>(plan, out_location, show_progress);
 }
 
 /// Runs a scene (particles and walls, no mill): plans first so that a config that cannot run
@@ -127,16 +157,9 @@ MillResult run_job(const MillConfig& config, bool show_progress) {
 int run_scene_command(const millsim::SceneConfig& scene, const JobOptions& options) {
   const millsim::ScenePlan plan = millsim::plan_scene(scene);
   const std::filesystem::path out = scene.output_directory;
-  if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
-    throw millsim::InputError(fmt::format(
-        "{}: output.directory: \"{}\" exists and is not a directory; allowed: a directory path",
-        scene.location_of("output.directory"), scene.output_directory));
-  }
+  prepare_output_directory(out, output_location(scene, options),
+                           {"summary.json", "trajectory.csv", "final.csv"});
   if (!options.quiet) fmt::print("millsim: running scene {}\n", scene.source);
-  std::filesystem::create_directories(out);
-  for (const char* name : {"summary.json", "trajectory.csv", "final.csv"}) {
-    std::filesystem::remove(out / name);
-  }
   ProgressLine progress(!options.quiet);
   const millsim::SceneResult result = millsim::run_scene(
       plan, out, [&](double time, double total) { progress(time, total, -1.0); });
@@ -156,7 +179,7 @@ int run_command(const JobOptions& options) {
   }
   const MillConfig& config = std::get<MillConfig>(job);
   if (!options.quiet) fmt::print("millsim: running {}\n", config.source);
-  const MillResult result = run_job(config, !options.quiet);
+  const MillResult result = run_job(config, output_location(config, options), !options.quiet);
   fmt::print("{}\n", millsim::summary_line(result));
   if (!options.quiet) {
     fmt::print(
@@ -252,6 +275,12 @@ int validate_command(const std::string& directory, const JobOptions& options) {
     if (entry.path().extension() == ".toml") cases.push_back(entry.path());
   }
   std::sort(cases.begin(), cases.end());
+  if (cases.empty()) {
+    throw millsim::InputError(fmt::format(
+        "{}: no validation configs in it; allowed: a directory of *.toml mill configs with a "
+        "[reference] table (examples/validation)",
+        directory));
+  }
   const std::string root =
       options.output_directory.empty() ? "runs/validation" : options.output_directory;
   struct Row {
@@ -268,7 +297,8 @@ int validate_command(const std::string& directory, const JobOptions& options) {
           fmt::format("{}: a validation config needs a [reference] table", path.string()));
     }
     fmt::print(stderr, "running {} ...\n", path.string());
-    const MillResult result = run_job(config, !options.quiet);
+    const MillResult result =
+        run_job(config, config.location_of("output.directory"), !options.quiet);
     rows.push_back({config.reference->case_name, config.reference->measured_kw,
                     config.reference->paper_kw.value_or(0.0), result.power_kw,
                     config.reference->tolerance});
@@ -326,8 +356,10 @@ std::vector<millsim::SweepRow> run_sweep(const std::vector<MillPlan>& plans,
     row.values = points[i];
     try {
       const MillPlan& plan = plans[i];
-      const MillResult result = plan.config.dimension == 2 ? run_job<2>(plan, show_progress)
-                                                           : run_job<3>(plan, show_progress);
+      const std::string location = fmt::format("sweep point {}", plan.config.output_directory);
+      const MillResult result = plan.config.dimension == 2
+                                    ? run_job<2>(plan, location, show_progress)
+                                    : run_job<3>(plan, location, show_progress);
       row.status = "ok";
       row.scalars = millsim::summary_scalars(result);
     } catch (const std::exception& error) {
@@ -374,7 +406,11 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
                parallel ? fmt::format("{} at a time", threads) : std::string("one at a time"));
     std::fflush(stdout);
   }
-  std::filesystem::create_directories(root);
+  prepare_output_directory(root,
+                           options.output_directory.empty()
+                               ? std::string("the default output directory")
+                               : fmt::format("command line (--out {})", root.string()),
+                           {"sweep.csv"});
   const std::vector<millsim::SweepRow> rows =
       run_sweep(plans, axes, points, options.quiet, parallel);
   millsim::write_sweep_csv(root / "sweep.csv", axes, rows);
@@ -453,6 +489,23 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (options.threads > 0) omp_set_num_threads(options.threads);
+  // An empty path is a mistake, not a request for the default.
+  for (const CLI::App* command : {run, info, sweep}) {
+    if (command->parsed() && command->count("config") > 0 && options.config_path.empty()) {
+      fmt::print(stderr,
+                 "millsim: error: command line: config: an empty path; allowed: a config file, "
+                 "or none for the built-in example\n");
+      return 2;
+    }
+  }
+  for (const CLI::App* command : {run, validate, sweep}) {
+    if (command->parsed() && command->count("--out") > 0 && options.output_directory.empty()) {
+      fmt::print(stderr,
+                 "millsim: error: command line: --out: an empty path; allowed: a directory "
+                 "path\n");
+      return 2;
+    }
+  }
   try {
     if (run->parsed()) return run_command(options);
     if (info->parsed()) return info_command(options);
@@ -461,6 +514,11 @@ int main(int argc, char** argv) {
   } catch (const millsim::InputError& error) {
     fmt::print(stderr, "millsim: error: {}\n", error.what());
     return 2;
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr,
+               "millsim: failed: out of memory (millsim info prints the particle count; a ball "
+               "takes about 1.1 kB)\n");
+    return 1;
   } catch (const std::exception& error) {
     fmt::print(stderr, "millsim: failed: {}\n", error.what());
     return 1;

@@ -303,4 +303,54 @@ TEST_F(Cli, RefusesAMissingConfigFile) {
   EXPECT_TRUE(fs::is_empty(work_));
 }
 
+TEST_F(Cli, RefusesAnEmptyConfigPathOrOutputDirectory) {
+  // An empty argument is a slip (an unset shell variable), not a request for the defaults.
+  const Outcome config = millsim("run '' -o out -q");
+  EXPECT_EQ(config.status, 2) << config.err;
+  EXPECT_NE(config.err.find("config: an empty path"), std::string::npos) << config.err;
+  write_config(base_config);
+  const Outcome out = millsim(std::string("run mill.toml -q --out '' ") + tiny_run);
+  EXPECT_EQ(out.status, 2) << out.err;
+  EXPECT_NE(out.err.find("--out: an empty path"), std::string::npos) << out.err;
+  EXPECT_FALSE(fs::exists(work_ / "out"));
+}
+
+TEST_F(Cli, AnOutputDirectoryThatCannotBeMadeIsBadInputNamingTheOption) {
+  std::ofstream(work_ / "afile") << "not a directory\n";
+  write_config(base_config);
+  const Outcome o = millsim(std::string("run mill.toml -q --out afile/sub ") + tiny_run);
+  EXPECT_EQ(o.status, 2) << o.err;
+  EXPECT_TRUE(
+      o.err.starts_with("millsim: error: command line (--out afile/sub): "
+                        "output.directory: cannot make \"afile/sub\""))
+      << o.err;
+}
+
+TEST_F(Cli, ARunRemovesTheResultsAnEarlierRunLeftInItsDirectory) {
+  // A run stopped half-way must not leave the last run's power.csv beside its own files.
+  fs::create_directories(work_ / "out");
+  for (const char* name : {"power.csv", "power_timeseries.csv", "spectrum.csv",
+                           "charge_profile.csv", "summary.json", "notes.txt"}) {
+    std::ofstream(work_ / "out" / name) << "stale\n";
+  }
+  write_config(base_config);
+  // Refused at planning (1.7e10 steps of 1 ns are too many): nothing is touched.
+  EXPECT_EQ(millsim("run mill.toml -o out -q --set simulation.time_step=1e-9").status, 2);
+  EXPECT_EQ(read_all(work_ / "out" / "power.csv"), "stale\n");
+  // A run that starts removes the old results first; a file of the user's stays.
+  const Outcome o = millsim(std::string("run mill.toml -o out -q ") + tiny_run);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_NE(read_all(work_ / "out" / "power.csv"), "stale\n");
+  EXPECT_NE(read_all(work_ / "out" / "charge_profile.csv"), "stale\n");
+  EXPECT_EQ(read_all(work_ / "out" / "notes.txt"), "stale\n");
+}
+
+TEST_F(Cli, ValidateRefusesADirectoryWithoutConfigs) {
+  fs::create_directories(work_ / "empty");
+  const Outcome o = millsim("validate empty -o runs -q");
+  EXPECT_EQ(o.status, 2) << o.err;
+  EXPECT_NE(o.err.find("empty: no validation configs in it"), std::string::npos) << o.err;
+  EXPECT_FALSE(fs::exists(work_ / "runs"));
+}
+
 }  // namespace

@@ -188,11 +188,33 @@ void insert_number(toml::table& table, const SummaryNumber& number) {
   }
 }
 
+/// A snapshot file, written under a .partial name and renamed when complete (a run stopped
+/// while writing one leaves no half a file under the final name).
+class SnapshotFile {
+ public:
+  SnapshotFile(const std::filesystem::path& directory, int index)
+      : path_(directory / fmt::format("snapshot_{:06d}.csv", index)),
+        partial_(path_.string() + ".partial"),
+        out_(fmt::output_file(partial_.string())) {}
+  template <typename... Args>
+  void print(fmt::format_string<Args...> format, Args&&... args) {
+    out_.print(format, std::forward<Args>(args)...);
+  }
+  void commit() {
+    out_.close();
+    std::filesystem::rename(partial_, path_);
+  }
+
+ private:
+  std::filesystem::path path_;
+  std::filesystem::path partial_;
+  fmt::ostream out_;
+};
+
 }  // namespace
 
 void write_snapshot(const std::filesystem::path& directory, int index, const World<3>& world) {
-  const auto path = directory / fmt::format("snapshot_{:06d}.csv", index);
-  auto out = fmt::output_file(path.string());
+  SnapshotFile out(directory, index);
   const auto& p = world.particles();
   out.print("# time_s = {:.9g}, shell_angle_rad = {:.9g}\n", world.time(),
             world.walls().mill ? world.walls().mill->angle : 0.0);
@@ -208,11 +230,11 @@ void write_snapshot(const std::filesystem::path& directory, int index, const Wor
         "{:.7g},{:.7g}\n",
         id, x[0], x[1], x[2], v[0], v[1], v[2], w[0], w[1], w[2], p.radius[i], f[0], f[1], f[2]);
   }
+  out.commit();
 }
 
 void write_snapshot(const std::filesystem::path& directory, int index, const World<2>& world) {
-  const auto path = directory / fmt::format("snapshot_{:06d}.csv", index);
-  auto out = fmt::output_file(path.string());
+  SnapshotFile out(directory, index);
   const auto& p = world.particles();
   out.print("# time_s = {:.9g}, shell_angle_rad = {:.9g}\n", world.time(),
             world.walls().mill ? world.walls().mill->angle : 0.0);
@@ -223,6 +245,7 @@ void write_snapshot(const std::filesystem::path& directory, int index, const Wor
               p.position[i][1], p.velocity[i][0], p.velocity[i][1], p.angular_velocity[i],
               p.radius[i], p.force[i][0], p.force[i][1]);
   }
+  out.commit();
 }
 
 std::vector<std::pair<std::string, double>> summary_scalars(const MillResult& result) {
