@@ -398,6 +398,26 @@ TEST(Config, AnOverrideOfAnUnknownKeyNamesTheOption) {
              {"command line (--set mil.speed=0.7)", "mil: unknown table", "did you mean mill?"});
 }
 
+TEST(Config, AnOverrideGivesOneValueOnceAndNeverAWholeTable) {
+  // The second of two would win unseen; a table would drop every key of the file's table.
+  expect_has(error_of(base_config, {"mill.speed=0.6", "mill.speed=0.7"}),
+             {"command line (--set mill.speed=0.7)", "mill.speed: given twice",
+              "also as --set mill.speed=0.6", "allowed: each key once"});
+  expect_has(error_of(base_config, {"mill={diameter = 1.0, length = 0.15, speed = 0.5}"}),
+             {"mill: a table would replace all of [mill]", "--set mill.KEY=VALUE"});
+  // An array of tables is a value, not a table.
+  const MillConfig sized =
+      parse_mill_config(with(base_config, "ball_diameter", ""), file_name,
+                        {"charge.sizes=[{diameter = 0.05, mass_fraction = 1.0}]"});
+  EXPECT_EQ(sized.sizes.size(), 1u);
+}
+
+TEST(Config, RefusesANulInTheOutputPath) {
+  // TOML allows \u0000 in a string; a path would be cut at it.
+  expect_has(error_of(with(base_config, "directory", "directory = \"out\\u0000x\"")),
+             {"output.directory", "a NUL character is not allowed"});
+}
+
 TEST(Config, AnOverrideWithABadValueNamesTheOption) {
   expect_has(error_of(base_config, {"mill.diameter=-1"}),
              {"command line (--set mill.diameter=-1)", "mill.diameter", "-1 is not allowed",

@@ -334,6 +334,11 @@ ContactMaterial read_material(TableReader section) {
 std::string read_output_directory(TableReader& section) {
   const std::string directory_rule = "a directory path (a non-empty string)";
   std::string directory = section.string("directory", "out", directory_rule);
+  if (directory.find('\0') != std::string::npos) {
+    section.fail_at(
+        "directory",
+        fmt::format("a NUL character is not allowed in a path; allowed: {}", directory_rule));
+  }
   if (directory.empty()) {
     section.fail_at("directory",
                     fmt::format("an empty path is not allowed; allowed: {}", directory_rule));

@@ -389,6 +389,7 @@ TableReader TableReader::table(std::string_view key, bool required, std::string_
 }
 
 void apply_overrides(toml::table& document, const std::vector<std::string>& overrides) {
+  std::vector<std::pair<std::string, std::string>> given;  // key, option: each key once
   for (const std::string& text : overrides) {
     const std::string option = fmt::format("{}{}", override_prefix, printable(text));
     const std::string where = fmt::format("command line ({})", option);
@@ -416,6 +417,20 @@ void apply_overrides(toml::table& document, const std::vector<std::string>& over
     }
     toml::table parsed =
         parse_override_value(trim(std::string_view(text).substr(equals + 1)), option);
+    if (parsed.get("value")->is_table()) {
+      // It would replace the whole table, dropping every key of it the file gives.
+      throw InputError(fmt::format(
+          "{}: {}: a table would replace all of [{}] in the config; allowed: its keys one by one, "
+          "e.g. --set {}.KEY=VALUE",
+          where, printable(key), printable(key), printable(key)));
+    }
+    for (const auto& [earlier_key, earlier_option] : given) {
+      if (earlier_key == key) {
+        throw InputError(fmt::format("{}: {}: given twice, also as {}; allowed: each key once",
+                                     where, printable(key), earlier_option));
+      }
+    }
+    given.emplace_back(std::string(key), option);
 
     // Walk to the parent table, creating the missing tables with the option as their source.
     toml::table* table = &document;
