@@ -229,4 +229,18 @@ TEST(SceneRun, WritesTrajectoryFinalAndSummaryAndNothingPartial) {
   fs::remove_all(work, ignored);
 }
 
+TEST(SceneConfig, RefusesSpeedsSizesAndPlacesBeyondAnyScene) {
+  // Their squares and energies must stay finite (a speed of 1e300 wrote inf into the summary).
+  std::string fast(drop);
+  fast.replace(fast.find("velocity = [3.0, 0.0, -2.0]"), 27, "velocity = [1e300, 0.0, 0.0]");
+  expect_refused(
+      fast, {},
+      {"drop.toml:8", "particles[0].velocity", "1e+300 is out of range", "within ±10000"});
+  expect_refused(drop, {"particles=[{position = [0.0, 0.0, 0.5], diameter = 1e3}]"},
+                 {"particles[0].diameter", "at most 100"});
+  std::string far(drop);
+  far.replace(far.find("normal = [0.0, 0.0, 2.0]"), 24, "normal = [1e300, 1e300, 1e300]");
+  expect_refused(far, {}, {"walls[0].normal", "out of range"});
+}
+
 }  // namespace

@@ -454,12 +454,21 @@ std::string vector_rule(int dimension, std::string_view what) {
                         : fmt::format("an array [x, y, z] of three numbers ({})", what);
 }
 
+/// A vector of `dimension` numbers, each within ±limit (so that squares and energies made of
+/// them stay finite).
 std::array<double, 3> read_vector(TableReader& table, std::string_view key, int dimension,
-                                  std::string_view what, bool required) {
+                                  std::string_view what, bool required, double limit) {
   std::optional<std::vector<double>> fallback;
   if (!required) fallback = std::vector<double>(static_cast<std::size_t>(dimension), 0.0);
   const std::vector<double> v = table.numbers(key, static_cast<std::size_t>(dimension), fallback,
                                               vector_rule(dimension, what));
+  for (const double x : v) {
+    if (!(std::abs(x) <= limit)) {
+      table.fail_at(key, fmt::format("{} is out of range; allowed: {} with each number within "
+                                     "±{:g}",
+                                     x, vector_rule(dimension, what), limit));
+    }
+  }
   std::array<double, 3> out{};
   std::copy(v.begin(), v.end(), out.begin());
   return out;
@@ -505,18 +514,20 @@ void read_table_array(TableReader& root, std::string_view key, std::string_view 
 SceneParticle read_scene_particle(TableReader p, int dimension) {
   p.allow_keys({"position", "velocity", "angular_velocity", "diameter", "density", "material"});
   SceneParticle particle;
-  particle.position = read_vector(p, "position", dimension, "m", true);
-  particle.velocity = read_vector(p, "velocity", dimension, "m/s; default [0, 0...]", false);
+  particle.position = read_vector(p, "position", dimension, "m", true, 1e6);
+  particle.velocity = read_vector(p, "velocity", dimension, "m/s; default [0, 0...]", false, 1e4);
   if (dimension == 2) {
     particle.angular_velocity[0] = p.number("angular_velocity", 0.0,
-                                            "a number of rad/s (the spin of a disc about the "
-                                            "out-of-plane axis, counter-clockwise positive)",
-                                            [](double) { return true; });
+                                            "a number of rad/s within ±1e6 (the spin of a disc "
+                                            "about the out-of-plane axis, counter-clockwise "
+                                            "positive)",
+                                            [](double w) { return std::abs(w) <= 1e6; });
   } else {
     particle.angular_velocity =
-        read_vector(p, "angular_velocity", 3, "rad/s; default [0, 0, 0]", false);
+        read_vector(p, "angular_velocity", 3, "rad/s; default [0, 0, 0]", false, 1e6);
   }
-  particle.diameter = p.number("diameter", std::nullopt, "a number of metres > 0", positive);
+  particle.diameter = p.number("diameter", std::nullopt, "a number of metres > 0, at most 100",
+                               [](double d) { return d > 0.0 && d <= 100.0; });
   particle.density = p.number("density", 7800.0, "a number of kg/m3 from 10 to 1e5 (default 7800)",
                               [](double rho) { return rho >= 10.0 && rho <= 1e5; });
   const std::string material = p.string(
@@ -534,9 +545,9 @@ SceneParticle read_scene_particle(TableReader p, int dimension) {
 SceneWall read_scene_wall(TableReader w, int dimension) {
   w.allow_keys({"point", "normal"});
   SceneWall wall;
-  wall.point = read_vector(w, "point", dimension, "a point of the plane, m", true);
+  wall.point = read_vector(w, "point", dimension, "a point of the plane, m", true, 1e6);
   wall.normal =
-      read_vector(w, "normal", dimension, "not zero; points to the particles' side", true);
+      read_vector(w, "normal", dimension, "not zero; points to the particles' side", true, 1e6);
   double length = 0.0;
   for (const double x : wall.normal) length += x * x;
   length = std::sqrt(length);
