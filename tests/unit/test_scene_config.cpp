@@ -243,4 +243,22 @@ TEST(SceneConfig, RefusesSpeedsSizesAndPlacesBeyondAnyScene) {
   expect_refused(far, {}, {"walls[0].normal", "out of range"});
 }
 
+TEST(SceneConfig, AConfigThatIsNeitherAMillNorASceneSaysSo) {
+  // Without [mill] or [[particles]], judging [simulation] by a mill's keys misled (duration
+  // "unknown").
+  for (const std::string_view text :
+       {std::string_view("[simulation]\nduration = 0.05\n"), std::string_view("")}) {
+    try {
+      millsim::parse_config(text, "drop.toml", {});
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const millsim::InputError& error) {
+      const std::string message = error.what();
+      EXPECT_NE(message.find("drop.toml: mill: missing required table [mill], and no "
+                             "[[particles]] either"),
+                std::string::npos)
+          << message;
+    }
+  }
+}
+
 }  // namespace

@@ -419,8 +419,8 @@ MillConfig read_mill_config(const toml::table& document, const std::string& sour
                   });
   read_simulation(root.table("simulation", false), config);
   read_mill(root.table("mill", true,
-                       "a table [mill] with diameter, length, speed or speed_rpm, and "
-                       "[mill.lifters]"),
+                       "a table [mill] with diameter, length and speed or speed_rpm "
+                       "([mill.lifters] optional)"),
             config);
   read_charge(root.table("charge", true,
                          "a table [charge] with filling and one of ball_diameter, top_size or "
@@ -716,6 +716,14 @@ JobConfig parse_config(std::string_view toml_text, const std::string& source,
   const toml::table document = parse_document(toml_text, source, overrides);
   if (is_scene(document) && (document.contains("particles") || document.contains("walls"))) {
     return read_scene_config(document, source);
+  }
+  if (is_scene(document)) {
+    // Neither kind: say so before any key of [simulation] is judged by the wrong kind's rules.
+    throw InputError(fmt::format(
+        "{}: mill: missing required table [mill], and no [[particles]] either; allowed: a mill "
+        "(a table [mill] with diameter, length and speed or speed_rpm, and [charge]) or a scene "
+        "([[particles]] and [[walls]], no [mill]; README, \"Scenes\")",
+        source));
   }
   return read_mill_config(document, source);
 }
