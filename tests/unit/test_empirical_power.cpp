@@ -278,8 +278,16 @@ TEST(EmpiricalPower, InputsFromThePlanOfCase2Dg) {
   EXPECT_FORMULA(in.speed_fraction, 0.77 * std::sqrt(4.11 / (4.11 - 0.076)));
   EXPECT_NEAR(in.speed_fraction, 0.7772195, 1e-7);
   EXPECT_NEAR(in.repose_angle, 35.0 * pi / 180.0, 1e-15);
-  // The three models for the measured mill (1324 kW measured): Bond 1463.4 kW,
-  // Hogg–Fuerstenau 1285.0 kW, Morrell net 1436.9 kW (regression values of the checks above).
+  // The three models for the measured mill (1324 kW measured), worked independently of this
+  // code from the formulas of docs/empirical_power.md (in double precision, outside C++):
+  // M = 4680 × 0.34 × π 4.11²/4 × 5.49 = 115896.585 kg.
+  // Bond: kWb = 4.879 × 4.11^0.3 × (3.2 − 1.02) × φ (1 − 0.1/2^(9 − 10φ)) = 12.092974, plus
+  // S_s = 1.102 (76 − 51.375)/50.8 = 0.534188 (D > 3.3 m): 12.627162 kW/t × 115.896585 t
+  // = 1463.44497 kW.
+  // Hogg–Fuerstenau: θ − sin θ cos θ = 0.34 π gives θ = 1.3138911; (4π/3) N g ρ_b L R³ sin³θ
+  // sin 35°, N = 16.215997/60 rev/s: 1285.04465 kW.
+  // Morrell: φ_c = 0.35 (3.364 − 0.34) = 1.0584, θ_T = 3.9385331, θ_S = 0.9440857, then r̄, t_c,
+  // t_f, β, r_i and z as in the doc: net 1.26 P = 1436.91989 kW.
   const EmpiricalPower p = empirical_power(plan);
   EXPECT_NEAR(p.bond.power_kw, 1463.44497, 1e-3);
   EXPECT_NEAR(p.hogg_fuerstenau.power_kw, 1285.04465, 1e-3);
