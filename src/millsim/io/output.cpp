@@ -60,23 +60,30 @@ std::string spectrum_table(const MillResult& result) {
   std::string text = "energy_low_j,energy_high_j";
   for (const ContactType t : types) {
     const auto name = contact_type_name(t);
-    text += fmt::format(",{0}_count,{0}_per_s,{0}_energy_j", name);
+    text += fmt::format(",{0}_count,{0}_per_s,{0}_energy_j,{0}_cumulative_energy_j", name);
   }
-  text += ",ball_wall_count,ball_wall_per_s,ball_wall_energy_j\n";
+  text += ",ball_wall_count,ball_wall_per_s,ball_wall_energy_j,ball_wall_cumulative_energy_j\n";
+  // Cumulative: the energy of this bin's collisions and of every bin below it (MODEL.md §7).
+  std::vector<double> cumulative(types.size(), 0.0);
+  double wall_cumulative = 0.0;
   for (std::size_t bin = 0; bin < s.bin_count(); ++bin) {
     text += fmt::format("{:.4g},{:.4g}", s.bin_lower_edge(bin), s.bin_upper_edge(bin));
     long wall_count = 0;
     double wall_energy = 0.0;
-    for (const ContactType t : types) {
-      text += fmt::format(",{},{:.6g},{:.6g}", s.count(t, bin),
-                          static_cast<double>(s.count(t, bin)) / window, s.energy(t, bin));
+    for (std::size_t k = 0; k < types.size(); ++k) {
+      const ContactType t = types[k];
+      cumulative[k] += s.energy(t, bin);
+      text += fmt::format(",{},{:.6g},{:.6g},{:.6g}", s.count(t, bin),
+                          static_cast<double>(s.count(t, bin)) / window, s.energy(t, bin),
+                          cumulative[k]);
       if (t != ContactType::ball_ball) {
         wall_count += s.count(t, bin);
         wall_energy += s.energy(t, bin);
       }
     }
-    text += fmt::format(",{},{:.6g},{:.6g}\n", wall_count, static_cast<double>(wall_count) / window,
-                        wall_energy);
+    wall_cumulative += wall_energy;
+    text += fmt::format(",{},{:.6g},{:.6g},{:.6g}\n", wall_count,
+                        static_cast<double>(wall_count) / window, wall_energy, wall_cumulative);
   }
   return text;
 }
