@@ -133,9 +133,9 @@ MillResult run_job(const MillPlan& plan, const std::string& out_location, bool s
   const MillConfig& config = plan.config;
   millsim::World<D> world = millsim::build_mill_world<D>(plan);
   const std::filesystem::path out = config.output_directory;
-  prepare_output_directory(
-      out, out_location,
-      {"summary.json", "power.csv", "power_timeseries.csv", "spectrum.csv", "charge_profile.csv"});
+  prepare_output_directory(out, out_location,
+                           {"summary.json", "power.csv", "power_timeseries.csv", "spectrum.csv",
+                            "charge_profile.csv", "impacts.csv"});
   const std::filesystem::path snapshots = out / "snapshots";
   std::filesystem::remove_all(snapshots);
   if (config.snapshot_interval > 0.0) std::filesystem::create_directories(snapshots);
@@ -184,7 +184,7 @@ int run_command(const JobOptions& options) {
   if (!options.quiet) {
     fmt::print(
         "results in {}/ (summary.json, power.csv, power_timeseries.csv, spectrum.csv, "
-        "charge_profile.csv)\n",
+        "charge_profile.csv, impacts.csv)\n",
         config.output_directory);
   }
   return 0;

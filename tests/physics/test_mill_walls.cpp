@@ -321,5 +321,27 @@ TEST(MillWall, TheExampleMillRunsBitForBitTheSameTwice) {
   EXPECT_GT(a.kinetic_energy(), 0.0);
 }
 
+TEST(MillWall, ADiscDroppedInAStillShellFirstStrikesItWhereItFalls) {
+  // A disc let go at rest at x0 off the axis falls straight down and first touches the shell
+  // when its centre is R − r from the axis: at (x0, −sqrt((R − r)² − x0²)). The contact point
+  // lies on the same ray, so the collision begins at the angle of that point (ShellImpacts:
+  // counterclockwise from +x, for a shell that would turn counterclockwise).
+  for (const double x0 : {0.01, 0.2, -0.3}) {  // none at a bin edge (the angle is kept as a float)
+    SCOPED_TRACE(x0);
+    World<2> world = smooth_shell(0.0, Vec2{{0.0, -standard_gravity}});
+    world.particles().add(Vec2{{x0, 0.1}}, ball_radius, ball_mass);
+    ShellImpacts impacts(true);
+    world.record_impacts_in(&impacts);
+    for (long n = 0; n < 20000 && impacts.total_count(ContactType::ball_shell) == 0; ++n) {
+      world.step();
+    }
+    ASSERT_EQ(impacts.total_count(ContactType::ball_shell), 1);
+    const double reach = shell_radius - ball_radius;
+    const double expected = std::atan2(-std::sqrt(reach * reach - x0 * x0), x0);
+    EXPECT_EQ(impacts.count(ContactType::ball_shell, impacts.bin_of(expected)), 1)
+        << "expected at " << expected * 180.0 / pi << " degrees";
+  }
+}
+
 }  // namespace
 }  // namespace millsim

@@ -38,6 +38,30 @@ std::string power_table(const std::vector<PowerInterval>& rows, bool numbered) {
   return text;
 }
 
+/// Where the wall collisions began (ShellImpacts), one row a bin of angle.
+std::string impacts_table(const MillResult& result) {
+  std::vector<ContactType> types = {ContactType::ball_shell, ContactType::ball_lifter};
+  if (result.plan.config.dimension == 3) types.push_back(ContactType::ball_end_plate);
+  std::string text = "angle_low_rad,angle_high_rad";
+  for (const ContactType t : types) {
+    text += fmt::format(",{0}_count,{0}_per_s,{0}_energy_j", contact_type_name(t));
+  }
+  text += "\n";
+  if (!result.shell_impacts) return text;
+  const ShellImpacts& impacts = *result.shell_impacts;
+  const double window = result.window_end.time - result.window_start.time;
+  for (int k = 0; k < ShellImpacts::bins; ++k) {
+    text += fmt::format("{:.6f},{:.6f}", k * ShellImpacts::bin_width,
+                        (k + 1) * ShellImpacts::bin_width);
+    for (const ContactType t : types) {
+      text += fmt::format(",{},{:.6g},{:.6g}", impacts.count(t, k),
+                          static_cast<double>(impacts.count(t, k)) / window, impacts.energy(t, k));
+    }
+    text += "\n";
+  }
+  return text;
+}
+
 /// The liner layer's mean ball count by angle (ChargeProfile), one row a bin.
 std::string charge_profile_table(const MillResult& result) {
   std::string text = "angle_low_rad,angle_high_rad,liner_layer_balls\n";
@@ -299,6 +323,7 @@ void write_results(const std::filesystem::path& directory, const MillResult& res
   write_file(directory / "power_timeseries.csv", power_table(result.series, false));
   write_file(directory / "spectrum.csv", spectrum_table(result));
   write_file(directory / "charge_profile.csv", charge_profile_table(result));
+  write_file(directory / "impacts.csv", impacts_table(result));
   write_file(directory / "summary.json", summary_json(result));
 }
 

@@ -17,7 +17,8 @@ struct MillResult;
 void write_snapshot(const std::filesystem::path& directory, int index, const World<2>& world);
 void write_snapshot(const std::filesystem::path& directory, int index, const World<3>& world);
 
-/// summary.json, power.csv, power_timeseries.csv, spectrum.csv and charge_profile.csv.
+/// summary.json, power.csv, power_timeseries.csv, spectrum.csv, charge_profile.csv and
+/// impacts.csv.
 /// summary.json is written last, so its presence means the run finished.
 void write_results(const std::filesystem::path& directory, const MillResult& result);
 

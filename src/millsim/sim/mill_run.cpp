@@ -113,6 +113,8 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
       const MillConfig& c = plan.config;
       result.charge_profile.emplace(plan.radius, c.lifter_count > 0 ? c.lifter_height : 0.0,
                                     plan.angular_speed >= 0.0);
+      result.shell_impacts.emplace(plan.angular_speed >= 0.0);
+      world.record_impacts_in(&*result.shell_impacts);
     }
     if (turned >= full_angle) break;
     const double since = world.time() - rotation_start;
@@ -148,6 +150,7 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
     }
   }
   world.record_collisions_in(nullptr);
+  world.record_impacts_in(nullptr);
   result.window_end = sample(world);
   if (motion_samples > 0) {
     result.charge_centre *= 1.0 / motion_samples;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "millsim/measure/charge_profile.hpp"
+#include "millsim/measure/shell_impacts.hpp"
 #include "millsim/measure/spectrum.hpp"
 #include "millsim/sim/charge.hpp"
 
@@ -60,6 +61,8 @@ struct MillResult {
   /// The liner layer's balls by angle over the measured window, and from them the charge's toe
   /// and shoulder (ChargeProfile; sampled 50 times a revolution, with the charge's centre).
   std::optional<ChargeProfile> charge_profile;
+  /// Where the wall collisions ending in the measured window began, with their energy (slice).
+  std::optional<ShellImpacts> shell_impacts;
 };
 
 /// Called now and then with (simulated time, total time, revolutions so far).

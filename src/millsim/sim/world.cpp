@@ -435,11 +435,12 @@ template <int D>
 void World<D>::record_ended(const std::vector<EndedCollision>& ended,
                             const std::vector<std::uint32_t>& block_ended,
                             std::size_t block_capacity) {
-  if (spectrum_ == nullptr) return;
+  if (spectrum_ == nullptr && impacts_ == nullptr) return;
   for (std::size_t b = 0; b < block_ended.size(); ++b) {
     for (std::size_t k = 0; k < block_ended[b]; ++k) {
       const EndedCollision& e = ended[b * block_capacity + k];
-      spectrum_->record(e.type, e.energy);
+      if (spectrum_ != nullptr) spectrum_->record(e.type, e.energy);
+      if (impacts_ != nullptr) impacts_->record(e.type, e.start_angle, e.energy);
     }
   }
 }
@@ -1033,6 +1034,8 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
         while (slot < max_wall_contacts && slot_id[slot] >= 0) ++slot;
         if (slot == max_wall_contacts) continue;  // cannot happen: see max_wall_contacts
         slot_id[slot] = wall_id;
+        // A collision begins: where, for ShellImpacts (its history is fresh, all zero).
+        slot_history[slot].start_angle = std::atan2(contact[c].point[1], contact[c].point[0]);
       }
       seen |= 1U << static_cast<unsigned>(slot);
       // The slot's history, which the law reads and writes once the block's contacts are found:
@@ -1055,8 +1058,9 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
     }
     for (unsigned ended_slots = held & ~seen; ended_slots != 0; ended_slots &= ended_slots - 1) {
       const int slot = std::countr_zero(ended_slots);
-      block_ended[ended++] = {wall_contact_type(walls_.kind_of(slot_id[slot])),
-                              slot_history[slot].dissipated};
+      block_ended[ended++] = {.type = wall_contact_type(walls_.kind_of(slot_id[slot])),
+                              .start_angle = static_cast<float>(slot_history[slot].start_angle),
+                              .energy = slot_history[slot].dissipated};
       slot_history[slot] = WallHistory{};
       slot_id[slot] = -1;
     }
@@ -1459,7 +1463,8 @@ bool World<D>::run_stages_split_among_threads() {
         if (pair_status_[q] == PairStatus::touching) {
           dissipated += pair_energy_[q];
         } else if (pair_status_[q] == PairStatus::ended) {
-          pair_ended_[b * pair_block_ + ended++] = {ContactType::ball_ball, pair_energy_[q]};
+          pair_ended_[b * pair_block_ + ended++] = {.type = ContactType::ball_ball,
+                                                    .energy = pair_energy_[q]};
         }
       }
       pair_block_dissipated_[b] = dissipated;

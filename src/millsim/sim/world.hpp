@@ -11,6 +11,7 @@
 
 #include "millsim/contact/linear_spring_dashpot.hpp"
 #include "millsim/geometry/walls.hpp"
+#include "millsim/measure/shell_impacts.hpp"
 #include "millsim/measure/spectrum.hpp"
 #include "millsim/particles/material.hpp"
 #include "millsim/particles/particle_store.hpp"
@@ -156,6 +157,8 @@ class World {
 
   /// Collisions that end from now on are added to `spectrum` (nullptr: not recorded).
   void record_collisions_in(ImpactSpectrum* spectrum) { spectrum_ = spectrum; }
+  /// The same for where wall collisions began (nullptr: none).
+  void record_impacts_in(ShellImpacts* impacts) { impacts_ = impacts; }
 
   /// Advances the world by one time step.
   void step();
@@ -283,7 +286,7 @@ class World {
       pair_status_[pair] = PairStatus::ended;
       pair_energy_[pair] = energy;
     } else {
-      pair_ended_[begin + ended++] = {ContactType::ball_ball, energy};
+      pair_ended_[begin + ended++] = {.type = ContactType::ball_ball, .energy = energy};
     }
   }
   [[gnu::always_inline]] void record_pair_touch(std::uint32_t pair, double energy,
@@ -316,6 +319,9 @@ class World {
   /// worked out from the positions instead: stored_spring_energy).
   struct WallHistory : ContactHistory<D> {
     double overlap = 0.0;  ///< δ at the last evaluation, m
+    /// Where the collision began: std::atan2(y, x) of the contact point at its first step
+    /// (ShellImpacts).
+    double start_angle = 0.0;
   };
   /// A wall contact of a candidate (the contact itself is kept beside it, in an array of
   /// WallContact): where its history is, and what the contact law made of it.
@@ -382,6 +388,7 @@ class World {
   /// same spectrum.
   struct EndedCollision {
     ContactType type = ContactType::ball_ball;
+    float start_angle = 0.0F;  ///< a wall collision's WallHistory::start_angle, rad
     double energy = 0.0;
   };
   void record_ended(const std::vector<EndedCollision>& ended,
@@ -394,6 +401,7 @@ class World {
   LinearSpringDashpot ball_wall_law_;
   NeighbourList<D> neighbours_;
   ImpactSpectrum* spectrum_ = nullptr;
+  ShellImpacts* impacts_ = nullptr;
 
   // u̇(n) ≈ u̇(n−½) + ½ ü(n−1) Δt and the same for ω: the velocities at the time of the
   // positions, which the dashpots and springs use so that the work they account for is the
