@@ -489,22 +489,23 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (options.threads > 0) omp_set_num_threads(options.threads);
-  // An empty path is a mistake, not a request for the default.
-  for (const CLI::App* command : {run, info, sweep}) {
-    if (command->parsed() && command->count("config") > 0 && options.config_path.empty()) {
-      fmt::print(stderr,
-                 "millsim: error: command line: config: an empty path; allowed: a config file, "
-                 "or none for the built-in example\n");
-      return 2;
-    }
+  // An empty path is a mistake (an unset shell variable), not a request for the default.
+  const auto given_empty = [](std::initializer_list<const CLI::App*> commands, const char* option,
+                              const std::string& value) {
+    return value.empty() && std::any_of(commands.begin(), commands.end(), [&](const CLI::App* c) {
+             return c->parsed() && c->count(option) > 0;
+           });
+  };
+  if (given_empty({run, info, sweep}, "config", options.config_path)) {
+    fmt::print(stderr,
+               "millsim: error: command line: config: an empty path; allowed: a config "
+               "file, or none for the built-in example\n");
+    return 2;
   }
-  for (const CLI::App* command : {run, validate, sweep}) {
-    if (command->parsed() && command->count("--out") > 0 && options.output_directory.empty()) {
-      fmt::print(stderr,
-                 "millsim: error: command line: --out: an empty path; allowed: a directory "
-                 "path\n");
-      return 2;
-    }
+  if (given_empty({run, validate, sweep}, "--out", options.output_directory)) {
+    fmt::print(stderr,
+               "millsim: error: command line: --out: an empty path; allowed: a directory path\n");
+    return 2;
   }
   try {
     if (run->parsed()) return run_command(options);
