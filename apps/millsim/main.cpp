@@ -484,6 +484,14 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     if (error.get_exit_code() == 0) return app.exit(error);  // --help
+    if (argc > 1 && argv[1][0] != '-' && app.get_subcommands().empty()) {
+      // CLI11 would say only that a command is required.
+      fmt::print(stderr,
+                 "millsim: error: command line: \"{}\" is not a command; allowed: run, info, "
+                 "validate or sweep (millsim --help)\n",
+                 argv[1]);
+      return 2;
+    }
     fmt::print(stderr, "millsim: error: command line: {}; allowed: see millsim --help\n",
                error.what());
     return 2;

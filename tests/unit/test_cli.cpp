@@ -345,6 +345,14 @@ TEST_F(Cli, ARunRemovesTheResultsAnEarlierRunLeftInItsDirectory) {
   EXPECT_EQ(read_all(work_ / "out" / "notes.txt"), "stale\n");
 }
 
+TEST_F(Cli, AnUnknownCommandIsNamed) {
+  const Outcome o = millsim("frobnicate mill.toml");
+  EXPECT_EQ(o.status, 2) << o.err;
+  EXPECT_NE(o.err.find("\"frobnicate\" is not a command; allowed: run, info, validate or sweep"),
+            std::string::npos)
+      << o.err;
+}
+
 TEST_F(Cli, ValidateRefusesADirectoryWithoutConfigs) {
   fs::create_directories(work_ / "empty");
   const Outcome o = millsim("validate empty -o runs -q");
