@@ -773,8 +773,13 @@ void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, st
 
 template <int D>
 void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint32_t* listed,
-                                              std::size_t count, double& dissipated,
-                                              std::uint32_t& ended, bool each_apart) {
+                                              std::size_t count, double& dissipated_sum,
+                                              std::uint32_t& ended_count, bool each_apart) {
+  // The block's dissipation and ended count are kept in registers and written back at the
+  // end: through the references each touching pair's addition was a load and a store the
+  // compiler could not keep apart from the force sums' (the same additions, in the same order).
+  double dissipated = dissipated_sum;
+  std::uint32_t ended = ended_count;
   using T = Lanes;
   constexpr auto lanes = static_cast<std::size_t>(lane_count);
   // The particles' arrays the step reads, by the names the law uses: v and ω at the time of the
@@ -926,6 +931,8 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
       }
     }
   }
+  dissipated_sum = dissipated;
+  ended_count = ended;
 }
 
 template <int D>
