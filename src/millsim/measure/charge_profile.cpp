@@ -6,15 +6,10 @@
 namespace millsim {
 
 ChargeProfile::ChargeProfile(double shell_radius, double lifter_height, bool turns_counterclockwise)
-    : shell_radius_(shell_radius),
-      lifter_height_(lifter_height),
-      direction_(turns_counterclockwise ? 1.0 : -1.0) {}
+    : shell_radius_(shell_radius), lifter_height_(lifter_height), angles_(turns_counterclockwise) {}
 
 double ChargeProfile::angle_of(double x, double y) const {
-  // From the rising side's horizontal, in the direction of the turn: counterclockwise from +x
-  // for a shell turning counterclockwise, its mirror image otherwise.
-  const double angle = std::atan2(y, direction_ * x);
-  return angle < 0.0 ? angle + 2.0 * pi : angle;
+  return angles_.of_point(x, y);
 }
 
 template <int D>
@@ -26,7 +21,7 @@ void ChargeProfile::add(const std::vector<Vec<D>>& position, const std::vector<d
     // Outer edge within h + d/2 of the shell: ρ + r >= R − h − r.
     const double inner = shell_radius_ - lifter_height_ - 2.0 * r;
     if (inner > 0.0 && x * x + y * y < inner * inner) continue;
-    const int bin = std::min(bins - 1, static_cast<int>(angle_of(x, y) / bin_width));
+    const int bin = MillAngles::bin_of(angle_of(x, y));
     ++counts_[static_cast<std::size_t>(bin)];
   }
   ++samples_;

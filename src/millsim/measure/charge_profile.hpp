@@ -6,8 +6,8 @@
 #include <optional>
 #include <vector>
 
-#include "millsim/core/constants.hpp"
 #include "millsim/core/vec.hpp"
+#include "millsim/measure/mill_angle.hpp"
 
 namespace millsim {
 
@@ -33,8 +33,8 @@ struct ToeAndShoulder {
 ///   layer only at the toe's impacts, add too little to move them.
 class ChargeProfile {
  public:
-  static constexpr int bins = 72;
-  static constexpr double bin_width = 2.0 * pi / bins;  ///< rad
+  static constexpr int bins = MillAngles::bins;
+  static constexpr double bin_width = MillAngles::bin_width;  ///< rad
 
   /// shell_radius R, m (the cylinder's); lifter_height h, m (0 without lifters);
   /// turns_counterclockwise: the shell's angular velocity points along +z.
@@ -56,7 +56,7 @@ class ChargeProfile {
  private:
   double shell_radius_;
   double lifter_height_;
-  double direction_;  ///< +1 counterclockwise, −1 clockwise
+  MillAngles angles_;
   int samples_ = 0;
   std::array<long, bins> counts_{};
 };

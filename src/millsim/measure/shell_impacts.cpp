@@ -5,8 +5,7 @@
 
 namespace millsim {
 
-ShellImpacts::ShellImpacts(bool turns_counterclockwise)
-    : direction_(turns_counterclockwise ? 1.0 : -1.0) {}
+ShellImpacts::ShellImpacts(bool turns_counterclockwise) : angles_(turns_counterclockwise) {}
 
 std::size_t ShellImpacts::index(ContactType type) {
   const auto found = std::find(types.begin(), types.end(), type);
@@ -14,10 +13,7 @@ std::size_t ShellImpacts::index(ContactType type) {
 }
 
 int ShellImpacts::bin_of(double lab_angle) const {
-  // A clockwise shell rises at −x: its angles are the mirror image, π − the lab angle.
-  double angle = direction_ > 0.0 ? lab_angle : pi - lab_angle;
-  angle -= 2.0 * pi * std::floor(angle / (2.0 * pi));
-  return std::clamp(static_cast<int>(angle / bin_width), 0, bins - 1);
+  return MillAngles::bin_of(angles_.of_lab(lab_angle));
 }
 
 void ShellImpacts::record(ContactType type, double lab_angle, double energy) {

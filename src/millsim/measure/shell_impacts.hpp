@@ -5,7 +5,7 @@
 #include <array>
 #include <vector>
 
-#include "millsim/core/constants.hpp"
+#include "millsim/measure/mill_angle.hpp"
 #include "millsim/measure/spectrum.hpp"
 
 namespace millsim {
@@ -18,8 +18,8 @@ namespace millsim {
 /// step of contact.
 class ShellImpacts {
  public:
-  static constexpr int bins = 72;
-  static constexpr double bin_width = 2.0 * pi / bins;  ///< rad
+  static constexpr int bins = MillAngles::bins;
+  static constexpr double bin_width = MillAngles::bin_width;  ///< rad
   /// The wall types counted, in the order of the columns of impacts.csv.
   static constexpr std::array<ContactType, 3> types = {
       ContactType::ball_shell, ContactType::ball_lifter, ContactType::ball_end_plate};
@@ -42,7 +42,7 @@ class ShellImpacts {
 
  private:
   static std::size_t index(ContactType type);
-  double direction_;  ///< +1 counterclockwise, −1 clockwise
+  MillAngles angles_;
   std::array<std::array<long, bins>, types.size()> counts_{};
   std::array<std::array<double, bins>, types.size()> energies_{};
 };
