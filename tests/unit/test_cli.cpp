@@ -245,6 +245,28 @@ TEST_F(Cli, InfoOfAConicalMillPrintsItsCones) {
   EXPECT_NE(info.out.find("particles             385"), std::string::npos) << info.out;
 }
 
+TEST_F(Cli, RefusesAFillingTheMillCannotHoldBothInRunAndInInfo) {
+  // J = 0.9 plans 226 discs (2D void fraction 0.2), more than fit between the lifters: the
+  // placement gives up, and `info`, which places the charge too, says so before printing.
+  const std::string text = with(base_config, "filling", "filling = 0.9");
+  const std::vector<std::string_view> parts = {"mill.toml", "charge.filling", "could not place",
+                                               "lower the filling or use smaller balls"};
+  const Outcome run = run_config(text);
+  expect_refused(run, {parts[0], parts[1], parts[2], parts[3]});
+  const Outcome info = millsim("info mill.toml");
+  EXPECT_EQ(info.status, 2) << info.err;
+  EXPECT_EQ(info.out, "");
+  EXPECT_EQ(info.err, run.err);
+
+  // The same mill at J = 0.3 (75 discs) is placed by info, which says so.
+  write_config(base_config);
+  const Outcome fits = millsim("info mill.toml");
+  ASSERT_EQ(fits.status, 0) << fits.err;
+  EXPECT_NE(fits.out.find("particles             75, placed without overlap as run places them"),
+            std::string::npos)
+      << fits.out;
+}
+
 TEST_F(Cli, RefusesConesOnA2DMill) {
   const std::string text = with(base_config, "speed", "speed = 0.5\ncone_angle = 15");
   expect_refused(run_config(text),
