@@ -1,30 +1,18 @@
 #include "millsim/io/output.hpp"
 
 #include <fmt/format.h>
-#include <fmt/os.h>
 #include <toml++/toml.h>
 
 #include <cstdint>
-#include <fstream>
 #include <sstream>
 #include <string_view>
 
+#include "millsim/io/partial_file.hpp"
 #include "millsim/measure/empirical_power.hpp"
 #include "millsim/sim/mill_run.hpp"
 
 namespace millsim {
 namespace {
-
-/// Writes `text` to `path` through a temporary file, so that a reader never sees half a file.
-void write_file(const std::filesystem::path& path, const std::string& text) {
-  const std::filesystem::path temporary = path.string() + ".partial";
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    out << text;
-    if (!out) throw std::runtime_error(fmt::format("cannot write {}", temporary.string()));
-  }
-  std::filesystem::rename(temporary, path);
-}
 
 std::string power_table(const std::vector<PowerInterval>& rows, bool numbered) {
   std::string text = numbered ? "revolution," : "";
@@ -219,33 +207,10 @@ void insert_number(toml::table& table, const SummaryNumber& number) {
   }
 }
 
-/// A snapshot file, written under a .partial name and renamed when complete (a run stopped
-/// while writing one leaves no half a file under the final name).
-class SnapshotFile {
- public:
-  SnapshotFile(const std::filesystem::path& directory, int index)
-      : path_(directory / fmt::format("snapshot_{:06d}.csv", index)),
-        partial_(path_.string() + ".partial"),
-        out_(fmt::output_file(partial_.string())) {}
-  template <typename... Args>
-  void print(fmt::format_string<Args...> format, Args&&... args) {
-    out_.print(format, std::forward<Args>(args)...);
-  }
-  void commit() {
-    out_.close();
-    std::filesystem::rename(partial_, path_);
-  }
-
- private:
-  std::filesystem::path path_;
-  std::filesystem::path partial_;
-  fmt::ostream out_;
-};
-
 }  // namespace
 
 void write_snapshot(const std::filesystem::path& directory, int index, const World<3>& world) {
-  SnapshotFile out(directory, index);
+  PartialFile out(directory / fmt::format("snapshot_{:06d}.csv", index));
   const auto& p = world.particles();
   out.print("# time_s = {:.9g}, shell_angle_rad = {:.9g}\n", world.time(),
             world.walls().mill ? world.walls().mill->angle : 0.0);
@@ -265,7 +230,7 @@ void write_snapshot(const std::filesystem::path& directory, int index, const Wor
 }
 
 void write_snapshot(const std::filesystem::path& directory, int index, const World<2>& world) {
-  SnapshotFile out(directory, index);
+  PartialFile out(directory / fmt::format("snapshot_{:06d}.csv", index));
   const auto& p = world.particles();
   out.print("# time_s = {:.9g}, shell_angle_rad = {:.9g}\n", world.time(),
             world.walls().mill ? world.walls().mill->angle : 0.0);
@@ -319,12 +284,12 @@ std::string summary_line(const MillResult& r) {
 }
 
 void write_results(const std::filesystem::path& directory, const MillResult& result) {
-  write_file(directory / "power.csv", power_table(result.revolutions, true));
-  write_file(directory / "power_timeseries.csv", power_table(result.series, false));
-  write_file(directory / "spectrum.csv", spectrum_table(result));
-  write_file(directory / "charge_profile.csv", charge_profile_table(result));
-  write_file(directory / "impacts.csv", impacts_table(result));
-  write_file(directory / "summary.json", summary_json(result));
+  write_whole_file(directory / "power.csv", power_table(result.revolutions, true));
+  write_whole_file(directory / "power_timeseries.csv", power_table(result.series, false));
+  write_whole_file(directory / "spectrum.csv", spectrum_table(result));
+  write_whole_file(directory / "charge_profile.csv", charge_profile_table(result));
+  write_whole_file(directory / "impacts.csv", impacts_table(result));
+  write_whole_file(directory / "summary.json", summary_json(result));
 }
 
 }  // namespace millsim

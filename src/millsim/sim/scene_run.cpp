@@ -6,11 +6,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <limits>
 
 #include "millsim/core/constants.hpp"
 #include "millsim/core/error.hpp"
+#include "millsim/io/partial_file.hpp"
 
 namespace millsim {
 namespace {
@@ -89,44 +89,6 @@ template <int D>
 std::string header() {
   return D == 2 ? "time,id,x,y,vx,vy,w\n" : "time,id,x,y,z,vx,vy,vz,wx,wy,wz\n";
 }
-
-/// A file written under NAME.partial and renamed to NAME when closed complete.
-class OutputFile {
- public:
-  explicit OutputFile(std::filesystem::path path)
-      : path_(std::move(path)), partial_(path_.string() + ".partial") {
-    file_ = std::fopen(partial_.c_str(), "wb");
-    if (file_ == nullptr) {
-      throw InputError(
-          fmt::format("{}: cannot write; allowed: a writable output directory", partial_.string()));
-    }
-  }
-  ~OutputFile() {
-    if (file_ != nullptr) {
-      std::fclose(file_);
-      std::filesystem::remove(partial_);
-    }
-  }
-  OutputFile(const OutputFile&) = delete;
-  OutputFile& operator=(const OutputFile&) = delete;
-  std::FILE* get() { return file_; }
-  void write(const std::string& text) { std::fwrite(text.data(), 1, text.size(), file_); }
-  void commit() {
-    const bool failed = std::ferror(file_) != 0;
-    std::fclose(file_);
-    file_ = nullptr;
-    if (failed) {
-      std::filesystem::remove(partial_);
-      throw std::runtime_error(fmt::format("{}: write failed", path_.string()));
-    }
-    std::filesystem::rename(partial_, path_);
-  }
-
- private:
-  std::filesystem::path path_;
-  std::filesystem::path partial_;
-  std::FILE* file_ = nullptr;
-};
 
 std::string summary_json(const SceneResult& r) {
   const SceneConfig& c = r.plan.config;
@@ -257,7 +219,7 @@ SceneResult run_scene_in(const ScenePlan& plan, const std::filesystem::path& dir
   const ParticleStore<D>& p = world.particles();
   const std::size_t n = p.size();
 
-  OutputFile trajectory(directory / "trajectory.csv");
+  PartialFile trajectory(directory / "trajectory.csv");
   trajectory.write(header<D>());
   // At t = 0 the state of the config (the stored half-step velocities are set back by half a
   // step of gravity).
@@ -279,7 +241,7 @@ SceneResult run_scene_in(const ScenePlan& plan, const std::filesystem::path& dir
     }
     if (progress && step % report_every == 0) progress(world.time(), plan.config.duration);
   }
-  OutputFile final_state(directory / "final.csv");
+  PartialFile final_state(directory / "final.csv");
   final_state.write(header<D>());
   write_state(final_state.get(), world);
 
@@ -299,7 +261,7 @@ SceneResult run_scene_in(const ScenePlan& plan, const std::filesystem::path& dir
 
   trajectory.commit();
   final_state.commit();
-  OutputFile summary(directory / "summary.json");
+  PartialFile summary(directory / "summary.json");
   summary.write(summary_json(result));
   summary.commit();
   return result;

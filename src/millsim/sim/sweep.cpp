@@ -6,13 +6,13 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <optional>
 #include <set>
 #include <stdexcept>
 
 #include "millsim/core/error.hpp"
+#include "millsim/io/partial_file.hpp"
 
 namespace millsim {
 namespace {
@@ -282,14 +282,7 @@ std::string sweep_csv(const std::vector<SweepAxis>& axes, const std::vector<Swee
 
 void write_sweep_csv(const std::filesystem::path& path, const std::vector<SweepAxis>& axes,
                      const std::vector<SweepRow>& rows) {
-  const std::filesystem::path partial = path.string() + ".partial";
-  {
-    std::ofstream file(partial, std::ios::binary);
-    file << sweep_csv(axes, rows);
-    file.close();
-    if (!file) throw std::runtime_error(fmt::format("{}: cannot write", partial.string()));
-  }
-  std::filesystem::rename(partial, path);
+  write_whole_file(path, sweep_csv(axes, rows));
 }
 
 std::string sweep_table(const std::vector<SweepAxis>& axes, const std::vector<SweepRow>& rows) {

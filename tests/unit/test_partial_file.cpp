@@ -1,0 +1,87 @@
+// PartialFile: every output file is written under NAME.partial and appears under NAME only
+// when complete.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "millsim/core/error.hpp"
+#include "millsim/io/partial_file.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+class PartialFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    directory_ = fs::temp_directory_path() /
+                 ("millsim_partial_" + std::to_string(::getpid()) + "_" +
+                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(directory_);
+    fs::create_directories(directory_);
+  }
+  void TearDown() override { fs::remove_all(directory_); }
+
+  static std::string read(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+  /// The names of the files in the directory, in order.
+  std::string listing() const {
+    std::string names;
+    for (const auto& entry : fs::directory_iterator(directory_)) {
+      names += entry.path().filename().string() + ";";
+    }
+    return names;
+  }
+
+  fs::path directory_;
+};
+
+TEST_F(PartialFileTest, AppearsUnderItsNameOnlyWhenCommitted) {
+  const fs::path path = directory_ / "power.csv";
+  {
+    millsim::PartialFile file(path);
+    file.write("a,b\n");
+    file.print("{},{}\n", 1, 2.5);
+    EXPECT_EQ(listing(), "power.csv.partial;");
+    file.commit();
+  }
+  EXPECT_EQ(listing(), "power.csv;");
+  EXPECT_EQ(read(path), "a,b\n1,2.5\n");
+}
+
+TEST_F(PartialFileTest, LeavesNothingWhenAbandoned) {
+  // A run stopped by an exception while writing: neither the file nor its .partial remains.
+  {
+    millsim::PartialFile file(directory_ / "trajectory.csv");
+    file.write("half a row");
+  }
+  EXPECT_EQ(listing(), "");
+}
+
+TEST_F(PartialFileTest, ReplacesAnOlderFileWholeAndWritesWholeText) {
+  const fs::path path = directory_ / "summary.json";
+  millsim::write_whole_file(path, "old");
+  millsim::write_whole_file(path, "{\"power_kw\": 1}\n");
+  EXPECT_EQ(listing(), "summary.json;");
+  EXPECT_EQ(read(path), "{\"power_kw\": 1}\n");
+}
+
+TEST_F(PartialFileTest, RefusesADirectoryItCannotWriteNamingThePath) {
+  const fs::path path = directory_ / "no-such-directory" / "final.csv";
+  try {
+    millsim::PartialFile file(path);
+    FAIL() << "opened " << path;
+  } catch (const millsim::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path.string() + ".partial: cannot write"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
