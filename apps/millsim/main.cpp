@@ -272,9 +272,9 @@ int info_command(const JobOptions& options) {
   fmt::print("simulated time        {:.4g} s: settle {} s + {} revolutions; {:.3g} steps\n",
              plan.total_time, c.settle_time, c.revolutions, steps);
   const millsim::EmpiricalPower empirical = millsim::empirical_power(plan);
-  fmt::print(
-      "empirical power       Bond {:.4g} kW, Hogg-Fuerstenau {:.4g} kW, Morrell net {:.4g} kW\n",
-      empirical.bond.power_kw, empirical.hogg_fuerstenau.power_kw, empirical.morrell.net_kw);
+  fmt::print("empirical power       {}, Hogg-Fuerstenau {:.4g} kW, Morrell net {:.4g} kW\n",
+             millsim::bond_power_text(empirical.bond), empirical.hogg_fuerstenau.power_kw,
+             empirical.morrell.net_kw);
   return 0;
 }
 

@@ -110,6 +110,43 @@ TEST(EmpiricalPower, BondBallSizeFactorOnlyAboveThreePointThreeMetres) {
   EXPECT_LT(bond_ball_size_factor(4.0, 0.040), 0.0);
 }
 
+TEST(EmpiricalPower, BondDoesNotApplyWhereItsEquationGivesNoPositivePower) {
+  EmpiricalPowerInputs in;
+  in.diameter = 1.0;
+  in.filling = 0.4;
+  in.top_ball_diameter = 0.05;
+  in.ball_charge_mass = 1000.0;
+  // At 80 % of critical: 7.41608 kW (BondRoundNumberMill).
+  in.speed_fraction = 0.8;
+  EXPECT_TRUE(bond_power(in).applies);
+  EXPECT_EQ(bond_power_text(bond_power(in)), "Bond 7.416 kW");
+  // At 150 %: 2^(9 − 15) = 1/64, so the speed term is 1.5 × (1 − 6.4) = −8.1 and kWb < 0.
+  in.speed_fraction = 1.5;
+  EXPECT_FORMULA(bond_power(in).kw_per_ball_tonne, 4.879 * 2.0 * 1.5 * (1.0 - 6.4));
+  EXPECT_FALSE(bond_power(in).applies);
+  EXPECT_EQ(bond_power_text(bond_power(in)),
+            "Bond n/a (its equation gives no positive power for this mill)");
+  // A 150 m mill at 80 %: S_s = 1.102 × (50 − 1875)/50.8 = −39.59 kW/t outweighs
+  // 4.879 × 150^0.3 × 2 × 0.76 = 33.24 kW/t.
+  in.speed_fraction = 0.8;
+  in.diameter = 150.0;
+  EXPECT_FORMULA(bond_power(in).kw_per_ball_tonne,
+                 4.879 * std::pow(150.0, 0.3) * 2.0 * 0.76 + 1.102 * (50.0 - 1875.0) / 50.8);
+  EXPECT_FALSE(bond_power(in).applies);
+}
+
+TEST(EmpiricalPower, SummaryJsonLeavesOutBondsPowerWhereItDoesNotApply) {
+  MillResult result;
+  result.plan =
+      plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", {"mill.speed=1.5"}));
+  ASSERT_FALSE(empirical_power(result.plan).bond.applies);
+  const std::string json = summary_json(result);
+  EXPECT_EQ(json.find("\"bond_kw\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"hogg_fuerstenau_kw\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"kw_per_ball_tonne\""), std::string::npos) << json;
+  EXPECT_NE(summary_line(result).find("empirical: Bond n/a"), std::string::npos);
+}
+
 TEST(EmpiricalPower, SegmentHalfAngle) {
   // J = (θ − sin θ cos θ)/π: θ = π/2 for a half-full mill, 0 empty, π full.
   EXPECT_NEAR(segment_half_angle(0.5), pi / 2.0, 1e-14);

@@ -112,8 +112,9 @@ struct SummaryNumber {
 void append_empirical_numbers(std::vector<SummaryNumber>& numbers, const EmpiricalPower& p) {
   const EmpiricalPowerInputs& in = p.inputs;
   const MorrellPower& m = p.morrell;
+  // Bond's power only where its equation gives one (BondPower::applies).
+  if (p.bond.applies) numbers.push_back({"empirical.bond_kw", p.bond.power_kw});
   const std::vector<SummaryNumber> empirical{
-      {"empirical.bond_kw", p.bond.power_kw},
       {"empirical.hogg_fuerstenau_kw", p.hogg_fuerstenau.power_kw},
       {"empirical.morrell_net_kw", m.net_kw},
       {"empirical.inputs.diameter_m", in.diameter},
@@ -274,11 +275,11 @@ std::string summary_line(const MillResult& r) {
   const EmpiricalPower empirical = empirical_power(r.plan);
   return fmt::format(
       "power {:.4g} kW (dissipation {:.4g} kW, ±{:.2g} kW between revolutions) at {:.3g} rpm "
-      "({:.0f}% of critical); empirical: Bond {:.4g} kW, Hogg-Fuerstenau {:.4g} kW, Morrell "
+      "({:.0f}% of critical); empirical: {}, Hogg-Fuerstenau {:.4g} kW, Morrell "
       "net {:.4g} kW; {} {}, {} steps in {:.1f} s ({:.3g} particle-steps/s)",
       r.power_kw, r.power_dissipation_kw, r.power_std_kw, r.plan.speed_rpm,
-      100.0 * r.plan.speed_fraction, empirical.bond.power_kw, empirical.hogg_fuerstenau.power_kw,
-      empirical.morrell.net_kw, r.plan.particle_count,
+      100.0 * r.plan.speed_fraction, bond_power_text(empirical.bond),
+      empirical.hogg_fuerstenau.power_kw, empirical.morrell.net_kw, r.plan.particle_count,
       r.plan.config.dimension == 2 ? "discs" : "balls", r.steps, r.wall_seconds,
       r.particle_steps_per_second);
 }

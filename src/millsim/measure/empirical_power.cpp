@@ -1,5 +1,7 @@
 #include "millsim/measure/empirical_power.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -54,12 +56,18 @@ double bond_kw_per_ball_tonne(double diameter, double filling, double speed_frac
          bond_ball_size_factor(diameter, top_ball_diameter);
 }
 
+std::string bond_power_text(const BondPower& bond) {
+  if (bond.applies) return fmt::format("Bond {:.4g} kW", bond.power_kw);
+  return "Bond n/a (its equation gives no positive power for this mill)";
+}
+
 BondPower bond_power(const EmpiricalPowerInputs& in) {
   BondPower bond;
   bond.ball_size_factor = bond_ball_size_factor(in.diameter, in.top_ball_diameter);
   bond.kw_per_ball_tonne =
       bond_kw_per_ball_tonne(in.diameter, in.filling, in.speed_fraction, in.top_ball_diameter);
   bond.power_kw = bond.kw_per_ball_tonne * in.ball_charge_mass / 1000.0;
+  bond.applies = bond.kw_per_ball_tonne > 0.0;
   return bond;
 }
 

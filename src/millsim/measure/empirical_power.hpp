@@ -3,6 +3,8 @@
 // Pure functions of the mill's geometry, speed and charge; no simulation state.
 #pragma once
 
+#include <string>
+
 #include "millsim/core/constants.hpp"
 
 namespace millsim {
@@ -48,7 +50,15 @@ struct BondPower {
   double power_kw = 0.0;
   double kw_per_ball_tonne = 0.0;  ///< kWb, including the ball-size factor
   double ball_size_factor = 0.0;   ///< S_s, kW/t (0 for D <= 3.3 m)
+  /// Whether the equation gives a positive power (kWb > 0). Far outside the mills it was fitted
+  /// to it does not: its speed term turns negative above 1.23 of critical speed, and S_s makes
+  /// kWb negative in mills of about a hundred metres. There power_kw means nothing, and the
+  /// outputs say "n/a" instead of it.
+  bool applies = true;
 };
+
+/// "Bond 123.4 kW", or, where the equation does not apply, why not.
+std::string bond_power_text(const BondPower& bond);
 
 /// Hogg & Fuerstenau (1972): the charge as a rigid circular segment whose chord is tilted at the
 /// dynamic angle of repose α; the drive holds its centre of mass off the vertical:
