@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <system_error>
 #include <variant>
 #include <vector>
 
@@ -446,7 +448,21 @@ void add_job_options(CLI::App& command, JobOptions& options) {
   command
       .add_option("-j,--threads", options.threads,
                   "threads to use (default: all available cores); results do not depend on it")
-      ->check(CLI::Range(1, 1024));
+      ->check(CLI::Validator(
+          [](const std::string& text) -> std::string {
+            // CLI11's own Range says "Value abc not in range" of a word that is no number.
+            int value = 0;
+            const char* end = text.data() + text.size();
+            const auto [stop, error] = std::from_chars(text.data(), end, value);
+            if (error != std::errc{} || stop != end || value < 1 || value > 1024) {
+              return fmt::format(
+                  "\"{}\" is not allowed; allowed: a whole number of threads "
+                  "from 1 to 1024",
+                  text);
+            }
+            return {};
+          },
+          "1 to 1024"));
   command.add_flag("-q,--quiet", options.quiet, "print only the one-line summary");
 }
 
@@ -504,8 +520,27 @@ int main(int argc, char** argv) {
                  argv[1]);
       return 2;
     }
-    fmt::print(stderr, "millsim: error: command line: {}; allowed: see millsim --help\n",
-               error.what());
+    if (app.get_subcommands().empty()) {
+      // Nothing at all, or options before any command (they belong after it).
+      fmt::print(
+          stderr,
+          "millsim: error: command line: {}; allowed: run, info, validate or sweep, each "
+          "followed by its options (millsim --help)\n",
+          argc == 1 ? std::string("no command") : fmt::format("no command before \"{}\"", argv[1]));
+      return 2;
+    }
+    // The help of the command given, if any, lists what it takes.
+    std::string help = "millsim --help";
+    for (const CLI::App* command : {run, info, validate, sweep}) {
+      if (command->parsed()) help = fmt::format("millsim {} --help", command->get_name());
+    }
+    const std::string what = error.what();
+    // A validator's message already says what is allowed.
+    if (what.find("; allowed: ") != std::string::npos) {
+      fmt::print(stderr, "millsim: error: command line: {}\n", what);
+    } else {
+      fmt::print(stderr, "millsim: error: command line: {}; allowed: see {}\n", what, help);
+    }
     return 2;
   }
   if (options.threads > 0) omp_set_num_threads(options.threads);

@@ -375,6 +375,31 @@ TEST_F(Cli, AnUnknownCommandIsNamed) {
       << o.err;
 }
 
+TEST_F(Cli, NoCommandOrOptionsBeforeItAreRefusedListingTheCommands) {
+  for (const std::string args : {"", "-q"}) {
+    const Outcome o = millsim(args);
+    EXPECT_EQ(o.status, 2) << args << ": " << o.err;
+    EXPECT_TRUE(o.err.starts_with("millsim: error: command line: no command")) << o.err;
+    EXPECT_NE(o.err.find("allowed: run, info, validate or sweep"), std::string::npos) << o.err;
+  }
+  EXPECT_NE(millsim("-q").err.find("no command before \"-q\""), std::string::npos);
+}
+
+TEST_F(Cli, RefusesAThreadCountThatIsNoWholeNumberFromOneTo1024) {
+  for (const std::string threads : {"abc", "0", "4x", "2.5", "1025", "-3"}) {
+    const Outcome o = run_config(base_config, "-j " + threads);
+    expect_refused(o, {"--threads: \"" + threads +
+                       "\" is not allowed; allowed: a whole number of threads from 1 to 1024"});
+  }
+}
+
+TEST_F(Cli, AnOptionTheCommandDoesNotTakePointsToThatCommandsHelp) {
+  const Outcome o = millsim("sweep --bogus --vary mill.speed=0.5,0.6");
+  EXPECT_EQ(o.status, 2) << o.err;
+  EXPECT_NE(o.err.find("--bogus"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("allowed: see millsim sweep --help"), std::string::npos) << o.err;
+}
+
 TEST_F(Cli, ValidateRefusesADirectoryWithoutConfigs) {
   fs::create_directories(work_ / "empty");
   const Outcome o = millsim("validate empty -o runs -q");
