@@ -88,9 +88,11 @@ World<D> moving_scene(const MillPlan& plan, double inner, double compress, doubl
 /// Steps a copy of `scene` `steps` times on `threads` threads, recording the collisions that
 /// end.
 /// With avx2_lanes false, the pair stage's lanes use the instructions of any x86-64 processor
-/// instead of AVX2 (World::set_avx2_lanes).
+/// instead of AVX2 (World::set_avx2_lanes). With `shares`, the threads' runs start from those
+/// shares of the pairs' weight (World::set_run_shares) instead of even ones.
 template <int D>
-Outcome<D> step_on(const World<D>& scene, int steps, int threads, bool avx2_lanes = true) {
+Outcome<D> step_on(const World<D>& scene, int steps, int threads, bool avx2_lanes = true,
+                   const std::vector<double>& shares = {}) {
   const ThreadCount thread_count(threads);
   EXPECT_EQ(omp_get_max_threads(), threads);
   int team = 0;
@@ -102,6 +104,7 @@ Outcome<D> step_on(const World<D>& scene, int steps, int threads, bool avx2_lane
   EXPECT_EQ(team, threads) << "OpenMP did not give the team asked for";
   Outcome<D> outcome{scene, ImpactSpectrum{}, threads};
   outcome.world.set_avx2_lanes(avx2_lanes);
+  if (!shares.empty()) outcome.world.set_run_shares(shares);
   outcome.world.record_collisions_in(&outcome.spectrum);
   for (int n = 0; n < steps; ++n) outcome.world.step();
   outcome.world.record_collisions_in(nullptr);
@@ -217,6 +220,10 @@ TEST(Determinism, SagMill2DIsTheSameOnOneTwoAndThreeThreads) {
   // cores is fine: only the order of the sums is at stake).
   const Outcome<2> three = step_on(scene, 400, 3);
   expect_identical(one, three);
+  // The runs' ends where neither the weights nor the measured times would put them (a fifth
+  // and four fifths; three ways 0.6, 0.3 and 0.1), and from there balanced by the times.
+  expect_identical(one, step_on(scene, 400, 2, true, {0.2, 0.8}));
+  expect_identical(one, step_on(scene, 400, 3, true, {0.6, 0.3, 0.1}));
   // The pair stage's lanes without AVX2, where the processor has it (else the same run twice).
   EXPECT_EQ(one.world.avx2_lanes(), __builtin_cpu_supports("avx2") != 0);
   const Outcome<2> baseline = step_on(scene, 400, 1, false);
@@ -302,6 +309,8 @@ void expect_3d_scene_deterministic(bool periodic) {
   const Outcome<3> three = step_on(scene, 400, 3);
   expect_identical(one, three);
   expect_identical(one, step_on(scene, 400, 2, false));
+  expect_identical(one, step_on(scene, 400, 2, true, {0.75, 0.25}));
+  expect_identical(one, step_on(scene, 400, 3, true, {0.1, 0.2, 0.7}));
 
   const World<3>& world = one.world;
   EXPECT_GT(world.particles().size(), parallel_threshold);

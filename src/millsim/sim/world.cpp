@@ -65,6 +65,31 @@ std::size_t block_size_for(std::size_t items, std::size_t blocks, std::size_t sm
   return std::clamp(std::bit_ceil(std::max<std::size_t>(1, items / blocks)), smallest, largest);
 }
 
+}  // namespace
+
+std::vector<double> balanced_run_shares(const std::vector<double>& shares,
+                                        const std::vector<double>& weights,
+                                        const std::vector<double>& seconds) {
+  const std::size_t runs = shares.size();
+  for (std::size_t r = 0; r < runs; ++r) {
+    if (!(weights[r] > 0.0 && seconds[r] > 0.0)) return shares;
+  }
+  double speeds = 0.0;
+  for (std::size_t r = 0; r < runs; ++r) speeds += weights[r] / seconds[r];
+  const double even = 1.0 / static_cast<double>(runs);
+  std::vector<double> balanced(runs);
+  double total = 0.0;
+  for (std::size_t r = 0; r < runs; ++r) {
+    const double measured = weights[r] / seconds[r] / speeds;
+    balanced[r] = std::clamp(0.5 * (shares[r] + measured), 0.5 * even, 2.0 * even);
+    total += balanced[r];
+  }
+  for (double& share : balanced) share /= total;
+  return balanced;
+}
+
+namespace {
+
 /// Whether a list of `pairs` splits the step among `threads` threads.
 bool splits_among_threads(std::size_t pairs, int threads) {
   return threads > 1 && pairs >= parallel_pair_threshold;
@@ -464,23 +489,40 @@ void World<D>::split_pairs_among(int threads) {
   for (std::size_t q = 0; q < pairs; ++q) {
     total += touching[q] == TouchState::touching ? touching_weight : 1;
   }
+  // The weight does not count everything a run costs (its wall candidates, the blocks it
+  // shares), and one core may be slower than the other for a while: each run's share of the
+  // weight follows what its thread measured since the last split (balanced_run_shares).
+  if (split_share_.size() != ranges) {
+    split_share_.assign(ranges, 1.0 / static_cast<double>(ranges));
+  } else if (split_weight_.size() == ranges && run_seconds_.size() == ranges) {
+    split_share_ = balanced_run_shares(split_share_, split_weight_, run_seconds_);
+  }
+  run_seconds_.assign(ranges, 0.0);
+  split_weight_.assign(ranges, 0.0);
   split_particle_.assign(ranges + 1, static_cast<std::uint32_t>(count));
   split_pair_.assign(ranges + 1, static_cast<std::uint32_t>(pairs));
   split_particle_[0] = 0;
   split_pair_[0] = 0;
   std::size_t t = 1;
   std::size_t weight = 0;
+  std::size_t run_start_weight = 0;
+  double ends_at = split_share_[0] * static_cast<double>(total);  // where run t − 1 ends
   for (std::size_t i = 0; i < count && t < ranges; ++i) {
-    // Particle i starts range t once the ranges before it hold t / ranges of the weight.
-    while (t < ranges && weight * ranges >= t * total) {
+    // Particle i starts range t once the ranges before it hold their shares of the weight.
+    while (t < ranges && static_cast<double>(weight) >= ends_at) {
       split_particle_[t] = static_cast<std::uint32_t>(i);
       split_pair_[t] = first_begin[i];
+      // Each run's weight, for the next split's measure of its speed.
+      split_weight_[t - 1] = static_cast<double>(weight - run_start_weight);
+      run_start_weight = weight;
+      ends_at += split_share_[t] * static_cast<double>(total);
       ++t;
     }
     for (std::uint32_t q = first_begin[i]; q < first_begin[i + 1]; ++q) {
       weight += touching[q] == TouchState::touching ? touching_weight : 1;
     }
   }
+  split_weight_[t - 1] = static_cast<double>(total - run_start_weight);
   // Pairs whose second particle belongs to a later thread than their first (pairs are stored
   // with first < second, so never an earlier one).
   cross_pairs_.clear();
@@ -1398,6 +1440,7 @@ bool World<D>::run_stages_split_among_threads() {
     // The implicit barrier of the loop above: every cross pair's force is known.
     const auto team = static_cast<std::size_t>(omp_get_num_threads());
     for (auto t = static_cast<std::size_t>(omp_get_thread_num()); t < ranges; t += team) {
+      const double run_start = omp_get_wtime();
       const std::uint32_t own_begin = split_particle_[t];
       const std::uint32_t own_end = split_particle_[t + 1];
       // A wall block shared with earlier runs that holds this run's first candidates: done now,
@@ -1457,6 +1500,7 @@ bool World<D>::run_stages_split_among_threads() {
       }
       run.advance_below(own_end);
       moved = run.moved || moved;
+      run_seconds_[t] += omp_get_wtime() - run_start;
     }
 #pragma omp barrier
     const std::size_t mixed = mixed_blocks_.size();

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "millsim/contact/linear_spring_dashpot.hpp"
@@ -62,6 +63,14 @@ struct EnergyAccount {
 /// cell.
 inline constexpr int cell_order_interval = 10;
 
+/// The runs' shares of the pairs' weight for the next split among threads (World::step): each
+/// run's measured speed since the last split, weights[r] / seconds[r], as a share of all the
+/// runs' speeds, taken half the way from the current share and kept within a factor of two of
+/// an even share (then scaled to add up to one). Unchanged until every run has weight and time.
+std::vector<double> balanced_run_shares(const std::vector<double>& shares,
+                                        const std::vector<double>& weights,
+                                        const std::vector<double>& seconds);
+
 /// Flags that threads set and wait on within a step (World's shared wall blocks), each holding
 /// a number that grows from step to step. Nothing is in flight between steps, so a copy starts
 /// with none, and they are made again (zero, below any step's number) when needed.
@@ -100,6 +109,15 @@ class World {
   static constexpr int max_wall_contacts = D == 2 ? 4 : max_mill_contacts<3> + 1;
 
   World(const WorldSettings<D>& settings, const Walls<D>& walls);
+
+  /// The shares of the pairs' weight that the runs of a step split among threads start from,
+  /// one per thread (adding up to one); from then on they follow the runs' measured times
+  /// (balanced_run_shares). Where the runs end changes who does what, never a result: for tests
+  /// of that.
+  void set_run_shares(std::vector<double> shares) {
+    split_share_ = std::move(shares);
+    split_rebuild_ = -1;  // split again at the next step
+  }
 
   /// The particles, in the order the step works on them. Particles are added at the end;
   /// with cell ordering on (set_cell_order_interval) they are renumbered at neighbour-list
@@ -439,6 +457,12 @@ class World {
   std::vector<std::uint32_t> split_particle_{0}, split_pair_{0};
   int split_threads_ = 0;
   long split_rebuild_ = -1;
+  // Balancing the runs by their measured times (split_pairs_among): per run, its share of the
+  // pairs' weight, the weight it was given at the last split, and the seconds its thread has
+  // spent on it since. Where each run ends changes only who does what, never a result.
+  std::vector<double> split_share_;
+  std::vector<double> split_weight_;
+  std::vector<double> run_seconds_;
   std::vector<std::uint32_t> cross_pairs_;
   std::vector<PairForce> cross_force_;
   std::vector<PairStatus> pair_status_;

@@ -1,0 +1,57 @@
+// balanced_run_shares (sim/world.hpp): how the runs of a step split among threads follow their
+// measured times. Each value is worked by hand in the comment above its check.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "millsim/sim/world.hpp"
+
+namespace millsim {
+namespace {
+
+void expect_shares(const std::vector<double>& actual, const std::vector<double>& expected) {
+  ASSERT_EQ(actual.size(), expected.size());
+  double total = 0.0;
+  for (std::size_t r = 0; r < actual.size(); ++r) {
+    EXPECT_NEAR(actual[r], expected[r], 1e-12) << "run " << r;
+    total += actual[r];
+  }
+  EXPECT_NEAR(total, 1.0, 1e-12);
+}
+
+TEST(RunShares, ASlowerRunGetsLessHalfTheWay) {
+  // Equal weights, the second run three times slower: speeds 100 and 33.3, measured shares
+  // 0.75 and 0.25; half the way from 0.5 each: 0.625 and 0.375.
+  expect_shares(balanced_run_shares({0.5, 0.5}, {100.0, 100.0}, {1.0, 3.0}), {0.625, 0.375});
+}
+
+TEST(RunShares, BalancedRunsKeepTheirShares) {
+  // Weights 300 and 100 done in the same time each: speeds 3 : 1, measured 0.75 and 0.25 as
+  // now.
+  expect_shares(balanced_run_shares({0.75, 0.25}, {300.0, 100.0}, {2.0, 2.0}), {0.75, 0.25});
+}
+
+TEST(RunShares, ThreeRuns) {
+  // Speeds 10, 20 and 10 (weights 10, 40, 30 in 1, 2, 3 s): measured 0.25, 0.5, 0.25; half the
+  // way from even thirds: 0.291667, 0.416667, 0.291667 (within [1/6, 2/3]).
+  const double third = 1.0 / 3.0;
+  expect_shares(balanced_run_shares({third, third, third}, {10.0, 40.0, 30.0}, {1.0, 2.0, 3.0}),
+                {0.5 * (third + 0.25), 0.5 * (third + 0.5), 0.5 * (third + 0.25)});
+}
+
+TEST(RunShares, KeptWithinAFactorOfTwoOfEven) {
+  // Measured 0.01 and 0.99 (speeds 1 and 99) from 0.26 and 0.74: half the way 0.135 and 0.865;
+  // the first raised to a half of even, 0.25, then both scaled by 1 / 1.115: 0.224215 and
+  // 0.775785.
+  expect_shares(balanced_run_shares({0.26, 0.74}, {1.0, 99.0}, {1.0, 1.0}),
+                {0.25 / 1.115, 0.865 / 1.115});
+}
+
+TEST(RunShares, UnchangedUntilEveryRunIsTimed) {
+  const std::vector<double> shares{0.3, 0.7};
+  EXPECT_EQ(balanced_run_shares(shares, {100.0, 100.0}, {1.0, 0.0}), shares);
+  EXPECT_EQ(balanced_run_shares(shares, {0.0, 100.0}, {1.0, 1.0}), shares);
+}
+
+}  // namespace
+}  // namespace millsim
