@@ -224,6 +224,20 @@ TEST(Determinism, SagMill2DIsTheSameOnOneTwoAndThreeThreads) {
   // and four fifths; three ways 0.6, 0.3 and 0.1), and from there balanced by the times.
   expect_identical(one, step_on(scene, 400, 2, true, {0.2, 0.8}));
   expect_identical(one, step_on(scene, 400, 3, true, {0.6, 0.3, 0.1}));
+  {
+    // The shares take effect: the first of two runs ends earlier from a fifth of the weight
+    // than from a half.
+    const ThreadCount thread_count(2);
+    World<2> even = scene;
+    World<2> fifth = scene;
+    fifth.set_run_shares({0.2, 0.8});
+    even.step();
+    fifth.step();
+    ASSERT_EQ(even.run_starts().size(), 3u);
+    ASSERT_EQ(fifth.run_starts().size(), 3u);
+    EXPECT_LT(fifth.run_starts()[1], even.run_starts()[1]);
+    EXPECT_GT(fifth.run_starts()[1], 0u);
+  }
   // The pair stage's lanes without AVX2, where the processor has it (else the same run twice).
   EXPECT_EQ(one.world.avx2_lanes(), __builtin_cpu_supports("avx2") != 0);
   const Outcome<2> baseline = step_on(scene, 400, 1, false);

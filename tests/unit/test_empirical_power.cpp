@@ -127,7 +127,7 @@ TEST(EmpiricalPower, BondDoesNotApplyWhereItsEquationGivesNoPositivePower) {
   EXPECT_EQ(bond_power_text(bond_power(in)),
             "Bond n/a (its equation gives no positive power for this mill)");
   // A 150 m mill at 80 %: S_s = 1.102 × (50 − 1875)/50.8 = −39.59 kW/t outweighs
-  // 4.879 × 150^0.3 × 2 × 0.76 = 33.24 kW/t.
+  // 4.879 × 150^0.3 × 2 × 0.76 = 33.34 kW/t.
   in.speed_fraction = 0.8;
   in.diameter = 150.0;
   EXPECT_FORMULA(bond_power(in).kw_per_ball_tonne,

@@ -6,9 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 #include <string>
 
-#include "millsim/core/error.hpp"
 #include "millsim/io/partial_file.hpp"
 
 namespace {
@@ -72,16 +72,26 @@ TEST_F(PartialFileTest, ReplacesAnOlderFileWholeAndWritesWholeText) {
   EXPECT_EQ(read(path), "{\"power_kw\": 1}\n");
 }
 
-TEST_F(PartialFileTest, RefusesADirectoryItCannotWriteNamingThePath) {
+TEST_F(PartialFileTest, FailsInADirectoryItCannotWriteNamingThePath) {
   const fs::path path = directory_ / "no-such-directory" / "final.csv";
   try {
     millsim::PartialFile file(path);
     FAIL() << "opened " << path;
-  } catch (const millsim::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(path.string() + ".partial: cannot write"),
-              std::string::npos)
-        << e.what();
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path.string() + ".partial: cannot write");
   }
+}
+
+TEST_F(PartialFileTest, ARenameThatFailsLeavesNothingAndSaysSo) {
+  // The final name is taken by a directory that is not empty: the rename fails, and the
+  // .partial goes too.
+  fs::create_directories(directory_ / "impacts.csv" / "inside");
+  millsim::PartialFile file(directory_ / "impacts.csv");
+  file.write("angle_rad,count\n");
+  EXPECT_THROW(file.commit(), std::runtime_error);
+  EXPECT_EQ(listing(), "impacts.csv;");
+  EXPECT_TRUE(fs::is_directory(directory_ / "impacts.csv"));
+  EXPECT_THROW(file.commit(), std::logic_error);
 }
 
 }  // namespace

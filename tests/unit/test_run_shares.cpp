@@ -47,10 +47,14 @@ TEST(RunShares, KeptWithinAFactorOfTwoOfEven) {
                 {0.25 / 1.115, 0.865 / 1.115});
 }
 
-TEST(RunShares, UnchangedUntilEveryRunIsTimed) {
+TEST(RunShares, UntimedOnlyBroughtWithinBounds) {
+  // A run not timed (no weight, or no time): shares within [0.25, 1] for two runs stay; an
+  // empty run's 0 is raised to 0.25, and with the other's 1 scaled by 1 / 1.25: 0.2 and 0.8.
   const std::vector<double> shares{0.3, 0.7};
-  EXPECT_EQ(balanced_run_shares(shares, {100.0, 100.0}, {1.0, 0.0}), shares);
-  EXPECT_EQ(balanced_run_shares(shares, {0.0, 100.0}, {1.0, 1.0}), shares);
+  expect_shares(balanced_run_shares(shares, {100.0, 100.0}, {1.0, 0.0}), shares);
+  expect_shares(balanced_run_shares(shares, {0.0, 100.0}, {1.0, 1.0}), shares);
+  expect_shares(balanced_run_shares({0.0, 1.0}, {0.0, 100.0}, {0.0, 1.0}), {0.2, 0.8});
+  expect_shares(balanced_run_shares(shares, {}, {}), shares);
 }
 
 }  // namespace

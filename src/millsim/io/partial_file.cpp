@@ -1,10 +1,9 @@
 #include "millsim/io/partial_file.hpp"
 
 #include <stdexcept>
+#include <string>
 #include <system_error>
 #include <utility>
-
-#include "millsim/core/error.hpp"
 
 namespace millsim {
 
@@ -12,8 +11,9 @@ PartialFile::PartialFile(std::filesystem::path path)
     : path_(std::move(path)), partial_(path_.string() + ".partial") {
   file_ = std::fopen(partial_.c_str(), "wb");
   if (file_ == nullptr) {
-    throw InputError(
-        fmt::format("{}: cannot write; allowed: a writable output directory", partial_.string()));
+    // A run failure (exit status 1), not refused input: the output directory was made and
+    // checked before the run began.
+    throw std::runtime_error(fmt::format("{}: cannot write", partial_.string()));
   }
 }
 
@@ -25,15 +25,18 @@ PartialFile::~PartialFile() {
 }
 
 void PartialFile::commit() {
+  if (file_ == nullptr) throw std::logic_error(fmt::format("{}: committed twice", path_.string()));
   const bool write_failed = std::ferror(file_) != 0;
   const bool close_failed = std::fclose(file_) != 0;
   file_ = nullptr;
-  if (write_failed || close_failed) {
+  std::error_code error;
+  if (!write_failed && !close_failed) std::filesystem::rename(partial_, path_, error);
+  if (write_failed || close_failed || error) {
     std::error_code ignored;
     std::filesystem::remove(partial_, ignored);
-    throw std::runtime_error(fmt::format("{}: write failed", path_.string()));
+    throw std::runtime_error(fmt::format("{}: write failed{}", path_.string(),
+                                         error ? ": " + error.message() : std::string()));
   }
-  std::filesystem::rename(partial_, path_);
 }
 
 void write_whole_file(const std::filesystem::path& path, std::string_view text) {

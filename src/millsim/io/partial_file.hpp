@@ -14,7 +14,7 @@ namespace millsim {
 
 class PartialFile {
  public:
-  /// Opens path.partial for writing; throws InputError if it cannot be made.
+  /// Opens path.partial for writing; throws std::runtime_error if it cannot be made.
   explicit PartialFile(std::filesystem::path path);
   ~PartialFile();
   PartialFile(const PartialFile&) = delete;
@@ -28,7 +28,7 @@ class PartialFile {
     fmt::print(file_, format, std::forward<Args>(args)...);
   }
   /// Closes the file and renames it to its final name; throws std::runtime_error (and removes
-  /// the .partial) if any write or the close failed, a full disk among them.
+  /// the .partial) if any write, the close or the rename failed, a full disk among them. Once.
   void commit();
 
  private:

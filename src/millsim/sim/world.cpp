@@ -71,17 +71,18 @@ std::vector<double> balanced_run_shares(const std::vector<double>& shares,
                                         const std::vector<double>& weights,
                                         const std::vector<double>& seconds) {
   const std::size_t runs = shares.size();
-  for (std::size_t r = 0; r < runs; ++r) {
-    if (!(weights[r] > 0.0 && seconds[r] > 0.0)) return shares;
-  }
+  bool timed = weights.size() >= runs && seconds.size() >= runs;
+  for (std::size_t r = 0; timed && r < runs; ++r) timed = weights[r] > 0.0 && seconds[r] > 0.0;
   double speeds = 0.0;
-  for (std::size_t r = 0; r < runs; ++r) speeds += weights[r] / seconds[r];
+  for (std::size_t r = 0; timed && r < runs; ++r) speeds += weights[r] / seconds[r];
   const double even = 1.0 / static_cast<double>(runs);
   std::vector<double> balanced(runs);
   double total = 0.0;
   for (std::size_t r = 0; r < runs; ++r) {
-    const double measured = weights[r] / seconds[r] / speeds;
-    balanced[r] = std::clamp(0.5 * (shares[r] + measured), 0.5 * even, 2.0 * even);
+    // Untimed (a run left empty, say), the shares are only brought within bounds, so that
+    // every run holds some weight and is timed next time.
+    const double aim = timed ? 0.5 * (shares[r] + weights[r] / seconds[r] / speeds) : shares[r];
+    balanced[r] = std::clamp(aim, 0.5 * even, 2.0 * even);
     total += balanced[r];
   }
   for (double& share : balanced) share /= total;

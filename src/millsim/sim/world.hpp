@@ -66,7 +66,8 @@ inline constexpr int cell_order_interval = 10;
 /// The runs' shares of the pairs' weight for the next split among threads (World::step): each
 /// run's measured speed since the last split, weights[r] / seconds[r], as a share of all the
 /// runs' speeds, taken half the way from the current share and kept within a factor of two of
-/// an even share (then scaled to add up to one). Unchanged until every run has weight and time.
+/// an even share (then scaled to add up to one). Until every run has weight and time, the
+/// shares are only brought within those bounds.
 std::vector<double> balanced_run_shares(const std::vector<double>& shares,
                                         const std::vector<double>& weights,
                                         const std::vector<double>& seconds);
@@ -118,6 +119,9 @@ class World {
     split_share_ = std::move(shares);
     split_rebuild_ = -1;  // split again at the next step
   }
+  /// Where the runs of the last step split among threads began, one past the last at the end
+  /// (particle indices; {0} before any such step).
+  const std::vector<std::uint32_t>& run_starts() const { return split_particle_; }
 
   /// The particles, in the order the step works on them. Particles are added at the end;
   /// with cell ordering on (set_cell_order_interval) they are renumbered at neighbour-list
