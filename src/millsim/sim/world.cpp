@@ -622,7 +622,7 @@ std::size_t World<D>::list_pairs_for_law(std::size_t begin, std::size_t end, std
     count = every_pair ? list_pairs_of<true, true>(begin, end, below, listed)
                        : list_pairs_of<true, false>(begin, end, below, listed);
 #if defined(__x86_64__)
-  } else if (D == 3 && every_pair && avx2_lanes_) {
+  } else if (every_pair && avx2_lanes_) {
     count = list_pairs_avx2(begin, end, listed);
 #endif
   } else {
@@ -664,9 +664,7 @@ constexpr std::array<KeptLanes, 16> kept_lanes = kept_lanes_table();
 template <int D>
 std::size_t World<D>::list_pairs_avx2(std::size_t begin, std::size_t end,
                                       std::uint32_t* listed) const {
-  if constexpr (D != 3) {
-    return list_pairs_of<false, true>(begin, end, end, listed);
-  } else {
+  {
     constexpr auto lanes = static_cast<std::size_t>(lane_count);
     const auto& first = neighbours_.first();
     const auto& second = neighbours_.second();
@@ -684,11 +682,18 @@ std::size_t World<D>::list_pairs_avx2(std::size_t begin, std::size_t end,
         j[l] = second[q + l];
       }
       // The operations of list_pairs_of, in the same order, each lane a pair.
-      const Vec<2, Lanes> planar = lanes_of(
-          [&](std::size_t l) { return planar_pair_of(x[j[l]]) - planar_pair_of(x[i[l]]); });
-      const Lanes dz = gather_lanes([&](std::size_t l) { return x[j[l]][2] - x[i[l]][2]; });
+      Lanes distance_squared{};
+      if constexpr (D == 2) {
+        const Vec<2, Lanes> offset =
+            lanes_of([&](std::size_t l) { return pair_of(x[j[l]]) - pair_of(x[i[l]]); });
+        distance_squared = offset[0] * offset[0] + offset[1] * offset[1];
+      } else {
+        const Vec<2, Lanes> planar = lanes_of(
+            [&](std::size_t l) { return planar_pair_of(x[j[l]]) - planar_pair_of(x[i[l]]); });
+        const Lanes dz = gather_lanes([&](std::size_t l) { return x[j[l]][2] - x[i[l]][2]; });
+        distance_squared = (planar[0] * planar[0] + planar[1] * planar[1]) + dz * dz;
+      }
       const Lanes reach = gather_lanes([&](std::size_t l) { return r[i[l]] + r[j[l]]; });
-      const Lanes distance_squared = (planar[0] * planar[0] + planar[1] * planar[1]) + dz * dz;
       auto keep = static_cast<unsigned>(
           __builtin_ia32_movmskpd256(reinterpret_cast<Lanes>(distance_squared < reach * reach)));
       // The four pairs' touch states, one byte each (0 or 1), gathered into bits 24 to 27.

@@ -296,7 +296,7 @@ class World {
   std::size_t list_pairs_of(std::size_t begin, std::size_t end, std::size_t below,
                             std::uint32_t* listed) const;
 #if defined(__x86_64__)
-  /// list_pairs_of<false, true> in 3D with AVX2, four pairs at a time: the same list.
+  /// list_pairs_of<false, true> with AVX2, four pairs at a time: the same list.
   __attribute__((target("avx2"))) std::size_t list_pairs_avx2(std::size_t begin, std::size_t end,
                                                               std::uint32_t* listed) const;
 #endif
