@@ -31,7 +31,7 @@ class PartialFileTest : public ::testing::Test {
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   }
   /// The names of the files in the directory, in order.
-  std::string listing() const {
+  [[nodiscard]] std::string listing() const {
     std::string names;
     for (const auto& entry : fs::directory_iterator(directory_)) {
       names += entry.path().filename().string() + ";";

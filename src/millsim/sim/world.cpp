@@ -485,11 +485,12 @@ void World<D>::split_pairs_among(int threads) {
   // threads, with a weight of 4 the thread holding the dense bottom of the charge finished its
   // pairs 12 % later than the other; with 8, 3 % (bench/results.md).
   const auto& touching = neighbours_.touching();
-  constexpr std::size_t touching_weight = 8;
+  const auto pair_weight = [&touching](std::size_t q) -> std::size_t {
+    constexpr std::size_t touching_weight = 8;
+    return touching[q] == TouchState::touching ? touching_weight : 1;
+  };
   std::size_t total = 0;
-  for (std::size_t q = 0; q < pairs; ++q) {
-    total += touching[q] == TouchState::touching ? touching_weight : 1;
-  }
+  for (std::size_t q = 0; q < pairs; ++q) total += pair_weight(q);
   // The weight does not count everything a run costs (its wall candidates, the blocks it
   // shares), and one core may be slower than the other for a while: each run's share of the
   // weight follows what its thread measured since the last split (balanced_run_shares).
@@ -519,9 +520,7 @@ void World<D>::split_pairs_among(int threads) {
       ends_at += split_share_[t] * static_cast<double>(total);
       ++t;
     }
-    for (std::uint32_t q = first_begin[i]; q < first_begin[i + 1]; ++q) {
-      weight += touching[q] == TouchState::touching ? touching_weight : 1;
-    }
+    for (std::uint32_t q = first_begin[i]; q < first_begin[i + 1]; ++q) weight += pair_weight(q);
   }
   split_weight_[t - 1] = static_cast<double>(total - run_start_weight);
   // Pairs whose second particle belongs to a later thread than their first (pairs are stored
