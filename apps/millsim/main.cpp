@@ -271,8 +271,10 @@ int info_command(const JobOptions& options) {
   fmt::print("time step             {:.4g} s{} (stability limit {:.4g} s)\n", plan.time_step,
              c.time_step ? "" : " (auto)", plan.critical_time_step);
   const double steps = plan.total_time / plan.time_step;
-  fmt::print("simulated time        {:.4g} s: settle {} s + {} revolutions; {:.3g} steps\n",
-             plan.total_time, c.settle_time, c.revolutions, steps);
+  fmt::print(
+      "simulated time        {:.4g} s: settle {} s, then {} revolutions from a spin-up of "
+      "{:.4g} s; {:.3g} steps\n",
+      plan.total_time, c.settle_time, c.revolutions, plan.spin_up_time, steps);
   const millsim::EmpiricalPower empirical = millsim::empirical_power(plan);
   fmt::print("empirical power       {}, Hogg-Fuerstenau {:.4g} kW, Morrell net {:.4g} kW\n",
              millsim::bond_power_text(empirical.bond), empirical.hogg_fuerstenau.power_kw,

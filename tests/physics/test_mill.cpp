@@ -103,6 +103,10 @@ TEST(Mill, EnergyAccountClosesAndBothPowersAgree) {
   const MillResult r =
       run(lab_mill({"simulation.revolutions=4", "simulation.measure_revolutions=3"}));
   testing::expect_energy_account_closes(r);
+  // The run lasts as long as its plan says (what `info` and the progress line report): the
+  // last step ends the turn within one step of the planned total, spin-up included.
+  EXPECT_NEAR(r.simulated_seconds, r.plan.total_time, r.plan.time_step);
+  EXPECT_NEAR(static_cast<double>(r.steps), r.plan.total_time / r.plan.time_step, 1.0);
 }
 
 }  // namespace

@@ -53,8 +53,11 @@ TEST(MillPlan, CriticalSpeedAndSpeedFromAFractionOfIt) {
   EXPECT_HAND(plan.speed_rpm, 22.950169);
   EXPECT_HAND(plan.angular_speed, 2.4033361);
   EXPECT_HAND(plan.revolution_period, 2.6143598);
-  // Total time = settle 1 s + 6 revolutions × 2.6143598 s = 16.686159 s.
-  EXPECT_HAND(plan.total_time, 16.686159);
+  // The shell comes up to speed over a quarter of a period, 0.65358995 s, in which it turns as
+  // in half that time at full speed. Total time = settle 1 s + 0.65358995 s / 2 + 6 revolutions
+  // × 2.6143598 s = 1 + 0.32679498 + 15.686159 = 17.012954 s.
+  EXPECT_HAND(plan.spin_up_time, 0.65358995);
+  EXPECT_HAND(plan.total_time, 17.012954);
 }
 
 TEST(MillPlan, SpeedGivenInRpm) {
@@ -218,10 +221,10 @@ TEST(MillPlan, RefusesMillsThatCannotRunNamingTheKey) {
              {"charge.filling", "9.3e+07 discs", "at most 5e+07"});
   // 1e-9 of the volume: 75 discs at J = 0.3 become 2.5e-7 of one.
   expect_has(plan_error(lab_mill({"charge.filling=1e-9"})), {"charge.filling", "rounds to none"});
-  // 1 s of settling and 6 revolutions of 60/22.950170 = 2.6143604 s: 16.686 s, at 1e-9 s a step
-  // 1.67e10 steps.
+  // 1 s of settling, half the spin-up's quarter period and 6 revolutions of 60/22.950170 =
+  // 2.6143604 s: 17.013 s, at 1e-9 s a step 1.70e10 steps.
   expect_has(plan_error(lab_mill({"simulation.time_step=1e-9"})),
-             {"simulation.revolutions", "1.67e+10 steps", "at most 1e+10 steps"});
+             {"simulation.revolutions", "1.7e+10 steps", "at most 1e+10 steps"});
   MillConfig snapshots = lab_mill();
   snapshots.snapshot_interval = 1e-5;
   expect_has(plan_error(snapshots),

@@ -215,13 +215,16 @@ MillPlan plan_mill(const MillConfig& config) {
         config.source, std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall),
         plan.critical_time_step));
   }
-  plan.total_time = config.settle_time + config.revolutions * plan.revolution_period;
+  plan.spin_up_time = 0.25 * plan.revolution_period;
+  plan.total_time =
+      config.settle_time + 0.5 * plan.spin_up_time + config.revolutions * plan.revolution_period;
   const double steps = plan.total_time / plan.time_step;
   if (!(steps <= most_steps)) {
     throw InputError(fmt::format(
-        "{}: simulation.revolutions: {} s of settling and {} revolutions of {:.4g} s at a time "
-        "step of {:.4g} s is {:.3g} steps; allowed: at most {:.0e} steps (fewer revolutions, a "
-        "shorter settle_time, a faster mill.speed, or a longer simulation.time_step)",
+        "{}: simulation.revolutions: {} s of settling, the spin-up and {} revolutions of {:.4g} "
+        "s at a time step of {:.4g} s is {:.3g} steps; allowed: at most {:.0e} steps (fewer "
+        "revolutions, a shorter settle_time, a faster mill.speed, or a longer "
+        "simulation.time_step)",
         config.location_of("simulation.revolutions"), config.settle_time, config.revolutions,
         plan.revolution_period, plan.time_step, steps, most_steps));
   }

@@ -51,7 +51,12 @@ struct MillPlan {
   double contact_duration_ball_wall = 0.0;  ///< s, smallest ball
   double critical_time_step = 0.0;          ///< s, stability limit
   double time_step = 0.0;                   ///< s, in use
-  double total_time = 0.0;                  ///< s, settling + rotation
+  /// s, the shell's speed ramps up linearly from 0 over it after settling: a quarter of a
+  /// revolution's period, in which the shell turns an eighth of a revolution
+  double spin_up_time = 0.0;
+  /// s, settling + rotation: settle_time + spin_up_time / 2 + revolutions × revolution_period
+  /// (the ramp turns the shell as half its time at full speed would)
+  double total_time = 0.0;
 };
 
 /// Area of the part of a circle of `radius` below the horizontal line at `level` from its

@@ -56,7 +56,7 @@ std::pair<Vec2, double> charge_motion(const World<D>& world) {
 }  // namespace
 
 double spin_up_time(const MillPlan& plan) {
-  return 0.25 * plan.revolution_period;
+  return plan.spin_up_time;
 }
 
 template <int D>

@@ -80,7 +80,8 @@ extern template MillResult run_mill<2>(const MillPlan&, World<2>, const std::fil
 extern template MillResult run_mill<3>(const MillPlan&, World<3>, const std::filesystem::path&,
                                        const ProgressCallback&);
 
-/// Time for the shell to come up to speed: a quarter of a revolution at full speed.
+/// Time for the shell to come up to speed (MillPlan::spin_up_time): a quarter of a revolution's
+/// period.
 double spin_up_time(const MillPlan& plan);
 
 }  // namespace millsim
