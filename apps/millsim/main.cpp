@@ -6,9 +6,11 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <initializer_list>
 #include <new>
@@ -42,26 +44,25 @@ struct JobOptions {
   int threads = 0;  // 0: all available cores
 };
 
+/// The config, with --out (a path as typed, not a TOML value) in place of output.directory.
 MillConfig load(const JobOptions& options) {
-  std::vector<std::string> overrides = options.overrides;
-  if (!options.output_directory.empty()) {
-    overrides.push_back(fmt::format("output.directory={}", options.output_directory));
-  }
-  if (options.config_path.empty()) {
-    return millsim::parse_mill_config(millsim::builtin_example_toml,
-                                      std::string(millsim::builtin_example_name), overrides);
-  }
-  return millsim::load_mill_config(options.config_path, overrides);
+  MillConfig config = options.config_path.empty()
+                          ? millsim::parse_mill_config(millsim::builtin_example_toml,
+                                                       std::string(millsim::builtin_example_name),
+                                                       options.overrides)
+                          : millsim::load_mill_config(options.config_path, options.overrides);
+  if (!options.output_directory.empty()) config.output_directory = options.output_directory;
+  return config;
 }
 
 /// A mill or a scene config (a file without [mill] is a scene).
 millsim::JobConfig load_job(const JobOptions& options) {
   if (options.config_path.empty()) return load(options);
-  std::vector<std::string> overrides = options.overrides;
+  millsim::JobConfig job = millsim::load_config(options.config_path, options.overrides);
   if (!options.output_directory.empty()) {
-    overrides.push_back(fmt::format("output.directory={}", options.output_directory));
+    std::visit([&](auto& config) { config.output_directory = options.output_directory; }, job);
   }
-  return millsim::load_config(options.config_path, overrides);
+  return job;
 }
 
 /// A single progress line on stderr, redrawn in place; only when stderr is a terminal.
@@ -97,11 +98,24 @@ class ProgressLine {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-/// Creates the output directory `out` and removes the `results` an earlier run left in it, so
-/// that a run stopped half-way leaves no mixture of two runs' files. `location` names where the
-/// directory was given (config line, --set or --out) for the message if it cannot be made.
+/// What becomes of an earlier run's snapshots/ subdirectory: left (scenes write none), removed,
+/// or removed and made again empty.
+enum class Snapshots { untouched, removed, made };
+
+/// Creates the output directory `out`, checks that a file can be written in it, and removes the
+/// `results` (and snapshots/, for a mill) an earlier run left in it, so that a run stopped half-way
+/// leaves no mixture of two runs' files. Called before the simulation, so that a directory that
+/// cannot take the results is refused before any time is spent. `location` names where the
+/// directory was given (config line, --set or --out) for the message if it cannot be used.
 void prepare_output_directory(const std::filesystem::path& out, const std::string& location,
-                              std::initializer_list<const char*> results) {
+                              std::initializer_list<const char*> results,
+                              Snapshots snapshots = Snapshots::untouched) {
+  const auto refuse = [&](const std::string& what, const std::string& why) {
+    return millsim::InputError(
+        fmt::format("{}: output.directory: cannot {} \"{}\" ({}); allowed: a directory that "
+                    "can be created and written",
+                    location, what, out.string(), why));
+  };
   if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
     throw millsim::InputError(
         fmt::format("{}: output.directory: \"{}\" exists and is not a directory; allowed: a "
@@ -110,12 +124,25 @@ void prepare_output_directory(const std::filesystem::path& out, const std::strin
   }
   try {
     std::filesystem::create_directories(out);
-    for (const char* name : results) std::filesystem::remove(out / name);
   } catch (const std::filesystem::filesystem_error& error) {
-    throw millsim::InputError(fmt::format(
-        "{}: output.directory: cannot make \"{}\" ({}); allowed: a directory that can be "
-        "created and written",
-        location, out.string(), error.code().message()));
+    throw refuse("make", error.code().message());
+  }
+  // A file written and removed: a directory that exists but takes no files (read-only, full,
+  // immutable) is found now, not when the results are written at the end.
+  const std::filesystem::path probe = out / ".millsim-write-check";
+  std::FILE* file = std::fopen(probe.c_str(), "w");
+  if (file == nullptr) throw refuse("write in", std::strerror(errno));
+  const bool written = std::fputs("millsim\n", file) >= 0;
+  const bool closed = std::fclose(file) == 0;
+  std::error_code ignored;
+  std::filesystem::remove(probe, ignored);
+  if (!written || !closed) throw refuse("write in", "a test file could not be written");
+  try {
+    for (const char* name : results) std::filesystem::remove(out / name);
+    if (snapshots != Snapshots::untouched) std::filesystem::remove_all(out / "snapshots");
+    if (snapshots == Snapshots::made) std::filesystem::create_directories(out / "snapshots");
+  } catch (const std::filesystem::filesystem_error& error) {
+    throw refuse("clear earlier results from", error.code().message());
   }
 }
 
@@ -137,10 +164,9 @@ MillResult run_job(const MillPlan& plan, const std::string& out_location, bool s
   const std::filesystem::path out = config.output_directory;
   prepare_output_directory(out, out_location,
                            {"summary.json", "power.csv", "power_timeseries.csv", "spectrum.csv",
-                            "charge_profile.csv", "impacts.csv"});
+                            "charge_profile.csv", "impacts.csv"},
+                           config.snapshot_interval > 0.0 ? Snapshots::made : Snapshots::removed);
   const std::filesystem::path snapshots = out / "snapshots";
-  std::filesystem::remove_all(snapshots);
-  if (config.snapshot_interval > 0.0) std::filesystem::create_directories(snapshots);
   ProgressLine progress(show_progress);
   MillResult result = millsim::run_mill(plan, std::move(world), snapshots, std::ref(progress));
   progress.clear();
@@ -282,42 +308,75 @@ int info_command(const JobOptions& options) {
   return 0;
 }
 
-int validate_command(const std::string& directory, const JobOptions& options) {
-  std::vector<std::filesystem::path> cases;
-  if (!std::filesystem::is_directory(directory)) {
-    throw millsim::InputError(fmt::format("{}: not a directory of validation configs", directory));
+/// validate and sweep write each case or point to a directory of its own under --out: a
+/// `--set output.directory` there would be ignored, so it is refused.
+void refuse_output_directory_set(const JobOptions& options, const char* command) {
+  for (const std::string& setting : options.overrides) {
+    std::string key = setting.substr(0, setting.find('='));
+    key.erase(0, key.find_first_not_of(" \t"));
+    key.erase(key.find_last_not_of(" \t") + 1);
+    if (key == "output.directory") {
+      throw millsim::InputError(fmt::format(
+          "command line (--set {}): output.directory: {} writes each run to a directory of its "
+          "own under -o/--out; allowed: -o/--out DIR",
+          setting, command));
+    }
   }
+}
+
+/// Runs every config of `directory` (each with a [reference] table) and prints millsim's power
+/// against the measured one and the paper's. Every config is read and planned before any runs,
+/// so that a bad one refuses the whole validation and writes nothing.
+int validate_command(const std::string& directory, const JobOptions& options) {
+  const auto refuse_directory = [&](const std::string& what) {
+    return millsim::InputError(fmt::format(
+        "command line (validate {}): {}; allowed: a directory of *.toml mill configs, each with "
+        "a [reference] table (default examples/validation)",
+        directory, what));
+  };
+  if (!std::filesystem::is_directory(directory)) {
+    throw refuse_directory(std::filesystem::exists(directory) ? "not a directory"
+                                                              : "no such directory");
+  }
+  std::vector<std::filesystem::path> cases;
   for (const auto& entry : std::filesystem::directory_iterator(directory)) {
     if (entry.path().extension() == ".toml") cases.push_back(entry.path());
   }
   std::sort(cases.begin(), cases.end());
-  if (cases.empty()) {
-    throw millsim::InputError(fmt::format(
-        "{}: no validation configs in it; allowed: a directory of *.toml mill configs with a "
-        "[reference] table (examples/validation)",
-        directory));
-  }
-  const std::string root =
+  if (cases.empty()) throw refuse_directory("no *.toml configs in it");
+  refuse_output_directory_set(options, "validate");
+  const std::filesystem::path root =
       options.output_directory.empty() ? "runs/validation" : options.output_directory;
+  const std::string root_location =
+      options.output_directory.empty()
+          ? std::string("the default output directory (runs/validation)")
+          : fmt::format("command line (--out {})", options.output_directory);
+  std::vector<MillPlan> plans;
+  for (const auto& path : cases) {
+    MillConfig config = millsim::load_mill_config(path.string(), options.overrides);
+    if (!config.reference) {
+      throw millsim::InputError(fmt::format(
+          "{}: [reference]: missing; allowed: a validation config has a [reference] table with "
+          "case, measured_power_kw, and optionally paper_power_kw and tolerance",
+          path.string()));
+    }
+    config.output_directory = (root / path.stem()).string();
+    plans.push_back(millsim::plan_mill(config));
+  }
   struct Row {
     std::string name;
-    double measured, paper, predicted, tolerance;
+    double measured, predicted, tolerance;
+    std::optional<double> paper;
   };
   std::vector<Row> rows;
-  for (const auto& path : cases) {
-    std::vector<std::string> overrides = options.overrides;
-    overrides.push_back(fmt::format("output.directory={}/{}", root, path.stem().string()));
-    const MillConfig config = millsim::load_mill_config(path.string(), overrides);
-    if (!config.reference) {
-      throw millsim::InputError(
-          fmt::format("{}: a validation config needs a [reference] table", path.string()));
-    }
-    fmt::print(stderr, "running {} ...\n", path.string());
-    const MillResult result =
-        run_job(config, config.location_of("output.directory"), !options.quiet);
-    rows.push_back({config.reference->case_name, config.reference->measured_kw,
-                    config.reference->paper_kw.value_or(0.0), result.power_kw,
-                    config.reference->tolerance});
+  for (const MillPlan& plan : plans) {
+    const MillConfig& config = plan.config;
+    if (!options.quiet) fmt::print(stderr, "running {} ...\n", config.source);
+    const MillResult result = config.dimension == 2
+                                  ? run_job<2>(plan, root_location, !options.quiet)
+                                  : run_job<3>(plan, root_location, !options.quiet);
+    rows.push_back({config.reference->case_name, config.reference->measured_kw, result.power_kw,
+                    config.reference->tolerance, config.reference->paper_kw});
   }
   fmt::print("{:<8} {:>12} {:>12} {:>12} {:>9} {:>10}  {}\n", "case", "measured_kW", "paper_kW",
              "millsim_kW", "error_%", "paper_err%", "within");
@@ -326,9 +385,14 @@ int validate_command(const std::string& directory, const JobOptions& options) {
     const double error = (r.predicted - r.measured) / r.measured;
     const bool ok = std::abs(error) <= r.tolerance;
     failures += ok ? 0 : 1;
-    fmt::print("{:<8} {:>12.4g} {:>12.4g} {:>12.4g} {:>+9.1f} {:>+10.1f}  {} (±{:.0f}%)\n", r.name,
-               r.measured, r.paper, r.predicted, 100.0 * error,
-               100.0 * (r.paper - r.measured) / r.measured, ok ? "yes" : "NO", 100.0 * r.tolerance);
+    // A case without the paper's figure shows n/a in its two columns.
+    const std::string paper = r.paper ? fmt::format("{:.4g}", *r.paper) : std::string("n/a");
+    const std::string paper_error =
+        r.paper ? fmt::format("{:+.1f}", 100.0 * (*r.paper - r.measured) / r.measured)
+                : std::string("n/a");
+    fmt::print("{:<8} {:>12.4g} {:>12} {:>12.4g} {:>+9.1f} {:>10}  {} (±{:.0f}%)\n", r.name,
+               r.measured, paper, r.predicted, 100.0 * error, paper_error, ok ? "yes" : "NO",
+               100.0 * r.tolerance);
   }
   return failures == 0 ? 0 : 1;
 }
@@ -405,6 +469,7 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
   std::vector<millsim::SweepAxis> axes;
   for (const std::string& argument : vary_arguments) axes.push_back(millsim::parse_vary(argument));
   millsim::check_sweep_axes(axes);
+  refuse_output_directory_set(options, "sweep");
   const std::vector<std::vector<std::string>> points = millsim::cartesian_product(axes);
   const std::filesystem::path root =
       options.output_directory.empty() ? "runs/sweep" : options.output_directory;

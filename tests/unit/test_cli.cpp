@@ -404,8 +404,112 @@ TEST_F(Cli, ValidateRefusesADirectoryWithoutConfigs) {
   fs::create_directories(work_ / "empty");
   const Outcome o = millsim("validate empty -o runs -q");
   EXPECT_EQ(o.status, 2) << o.err;
-  EXPECT_NE(o.err.find("empty: no validation configs in it"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("command line (validate empty): no *.toml configs in it; allowed: a "
+                       "directory of *.toml mill configs"),
+            std::string::npos)
+      << o.err;
   EXPECT_FALSE(fs::exists(work_ / "runs"));
+  const Outcome missing = millsim("validate nodir -o runs -q");
+  EXPECT_EQ(missing.status, 2) << missing.err;
+  EXPECT_NE(missing.err.find("command line (validate nodir): no such directory; allowed:"),
+            std::string::npos)
+      << missing.err;
+}
+
+TEST_F(Cli, AnOutputDirectoryThatTakesNoFilesIsRefusedBeforeTheRun) {
+  // /proc/self exists and is a directory, but no file can be made in it, even by root (whom
+  // permission bits do not stop): found before the simulation, not when the results are written.
+  if (!fs::is_directory("/proc/self")) GTEST_SKIP() << "no /proc/self here";
+  write_config(base_config);
+  const Outcome o = millsim(std::string("run mill.toml -q --out /proc/self ") + tiny_run);
+  EXPECT_EQ(o.status, 2) << o.err;
+  EXPECT_TRUE(
+      o.err.starts_with("millsim: error: command line (--out /proc/self): "
+                        "output.directory: cannot write in \"/proc/self\""))
+      << o.err;
+  EXPECT_NE(o.err.find("allowed: a directory that can be created and written"), std::string::npos)
+      << o.err;
+}
+
+TEST_F(Cli, OutOverridesTheOutputDirectoryOfTheConfigAndOfSetAsAPlainPath) {
+  write_config(base_config);
+  const Outcome o =
+      millsim(std::string("run mill.toml -q --set output.directory=d1 --out d2 ") + tiny_run);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_TRUE(fs::exists(work_ / "d2" / "summary.json"));
+  EXPECT_FALSE(fs::exists(work_ / "d1"));
+  EXPECT_FALSE(fs::exists(work_ / "out"));
+  // The path as typed, quotes and all (not read as a TOML string).
+  const Outcome quoted_path = millsim(std::string("run mill.toml -q --out '\"q\"' ") + tiny_run);
+  ASSERT_EQ(quoted_path.status, 0) << quoted_path.err;
+  EXPECT_TRUE(fs::exists(work_ / "\"q\"" / "summary.json"));
+  EXPECT_FALSE(fs::exists(work_ / "q"));
+}
+
+/// A validation case of the base config: its [reference] table, and an [output] table that
+/// validate replaces.
+std::string validation_case(std::string_view reference) {
+  return std::string(base_config) + "\n[reference]\n" + std::string(reference);
+}
+
+TEST_F(Cli, ValidateReadsEveryCaseBeforeRunningAnyAndShowsAMissingPaperFigureAsNa) {
+  fs::create_directories(work_ / "cases");
+  std::ofstream(work_ / "cases" / "a.toml")
+      << validation_case("case = \"a\"\nmeasured_power_kw = 0.6\n");
+  // The second case's filling is impossible: nothing runs, nothing is written.
+  std::ofstream(work_ / "cases" / "b.toml")
+      << with(validation_case("case = \"b\"\nmeasured_power_kw = 0.6\npaper_power_kw = 0.62\n"),
+              "filling", "filling = 3");
+  const Outcome bad = millsim(std::string("validate cases -o runs ") + tiny_run);
+  EXPECT_EQ(bad.status, 2) << bad.err;
+  EXPECT_NE(bad.err.find("b.toml:" + std::to_string(line_of(base_config, "filling")) +
+                         ": charge.filling"),
+            std::string::npos)
+      << bad.err;
+  EXPECT_EQ(bad.err.find("running"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(work_ / "runs"));
+  // A case without [reference]: refused by name before any runs.
+  std::ofstream(work_ / "cases" / "b.toml") << base_config;
+  const Outcome unreferenced = millsim(std::string("validate cases -o runs ") + tiny_run);
+  EXPECT_EQ(unreferenced.status, 2) << unreferenced.err;
+  EXPECT_NE(unreferenced.err.find("b.toml: [reference]: missing; allowed:"), std::string::npos)
+      << unreferenced.err;
+  EXPECT_FALSE(fs::exists(work_ / "runs"));
+  // Both cases good; the first has no paper figure. -q: no line per case on stderr.
+  std::ofstream(work_ / "cases" / "b.toml")
+      << validation_case("case = \"b\"\nmeasured_power_kw = 0.6\npaper_power_kw = 0.62\n");
+  const Outcome good = millsim(std::string("validate cases -q -o runs ") + tiny_run);
+  EXPECT_TRUE(good.status == 0 || good.status == 1) << good.err;
+  EXPECT_EQ(good.err, "");
+  EXPECT_TRUE(fs::exists(work_ / "runs" / "a" / "summary.json"));
+  EXPECT_TRUE(fs::exists(work_ / "runs" / "b" / "summary.json"));
+  const auto row_of = [&](std::string_view name) {
+    std::istringstream lines(good.out);
+    std::string line;
+    while (std::getline(lines, line)) {
+      if (line.starts_with(name)) return line;
+    }
+    return std::string();
+  };
+  std::istringstream a(row_of("a "));
+  std::string name, measured, paper, predicted, error, paper_error;
+  a >> name >> measured >> paper >> predicted >> error >> paper_error;
+  EXPECT_EQ(paper, "n/a") << good.out;
+  EXPECT_EQ(paper_error, "n/a") << good.out;
+  std::istringstream b(row_of("b "));
+  b >> name >> measured >> paper >> predicted >> error >> paper_error;
+  EXPECT_EQ(paper, "0.62") << good.out;
+  EXPECT_EQ(paper_error, "+3.3") << good.out;
+  // validate places each case under --out itself: a --set of the directory is refused.
+  const Outcome set = millsim(std::string("validate cases -q -o runs2 ") + tiny_run +
+                              " --set output.directory=elsewhere");
+  EXPECT_EQ(set.status, 2) << set.err;
+  EXPECT_NE(set.err.find("command line (--set output.directory=elsewhere): output.directory: "
+                         "validate writes each run to a directory of its own"),
+            std::string::npos)
+      << set.err;
+  EXPECT_FALSE(fs::exists(work_ / "runs2"));
+  EXPECT_FALSE(fs::exists(work_ / "elsewhere"));
 }
 
 }  // namespace
