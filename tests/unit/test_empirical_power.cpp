@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -145,6 +147,26 @@ TEST(EmpiricalPower, SummaryJsonLeavesOutBondsPowerWhereItDoesNotApply) {
   EXPECT_NE(json.find("\"hogg_fuerstenau_kw\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"kw_per_ball_tonne\""), std::string::npos) << json;
   EXPECT_NE(summary_line(result).find("empirical: Bond n/a"), std::string::npos);
+}
+
+TEST(EmpiricalPower, SummaryJsonRefusesAFigureThatIsNotFinite) {
+  // JSON has no infinity or NaN: a diverged run is reported as failed, not written as "inf".
+  MillResult result;
+  result.plan = plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", {}));
+  result.power_kw = 0.5;
+  EXPECT_NO_THROW((void)summary_json(result));
+  result.power_dissipation_kw = std::numeric_limits<double>::infinity();
+  try {
+    (void)summary_json(result);
+    ADD_FAILURE() << "written";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("the run diverged: power_dissipation_kw is inf"),
+              std::string::npos)
+        << error.what();
+  }
+  result.power_dissipation_kw = 0.5;
+  result.charge_centre[1] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW((void)summary_json(result), std::runtime_error);
 }
 
 TEST(EmpiricalPower, SegmentHalfAngle) {

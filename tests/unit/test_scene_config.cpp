@@ -241,6 +241,10 @@ TEST(SceneConfig, RefusesSpeedsSizesAndPlacesBeyondAnyScene) {
   std::string far(drop);
   far.replace(far.find("normal = [0.0, 0.0, 2.0]"), 24, "normal = [1e300, 1e300, 1e300]");
   expect_refused(far, {}, {"walls[0].normal", "out of range"});
+  // Gravity too (1e300 wrote inf and -inf into the summary).
+  expect_refused(drop, {"simulation.gravity=[0.0, 0.0, -1e300]"},
+                 {"simulation.gravity", "-1e+300 is out of range", "within ±10000"});
+  EXPECT_DOUBLE_EQ(scene(drop, {"simulation.gravity=[0.0, 0.0, -1e4]"}).gravity[2], -1e4);
 }
 
 TEST(SceneConfig, AConfigThatIsNeitherAMillNorASceneSaysSo) {

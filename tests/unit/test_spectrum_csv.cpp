@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "millsim/builtin_example.hpp"
+#include "millsim/io/config.hpp"
 #include "millsim/io/output.hpp"
 #include "millsim/sim/mill_run.hpp"
 
@@ -41,7 +43,8 @@ std::vector<std::map<std::string, double>> read_csv(const std::filesystem::path&
 
 TEST(SpectrumCsv, EachCollisionIsInItsBinWithRatesAndCumulativeEnergies) {
   MillResult result;
-  result.plan.config.dimension = 2;
+  // A real plan (the built-in 2D example), whose figures summary.json can write.
+  result.plan = plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", {}));
   result.window_start.time = 1.0;
   result.window_end.time = 3.0;  // 2 s measured
   ImpactSpectrum& s = result.spectrum;

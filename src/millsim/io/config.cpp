@@ -483,9 +483,20 @@ void read_scene_simulation(TableReader section, SceneConfig& config) {
                                    [](double t) { return t > 0.0 && t <= 1e4; });
   std::vector<double> down(static_cast<std::size_t>(config.dimension), 0.0);
   down.back() = -standard_gravity;
+  const std::string_view rule = "m/s2; default: -9.81 along the last axis";
   const std::vector<double> g =
       section.numbers("gravity", static_cast<std::size_t>(config.dimension), down,
-                      vector_rule(config.dimension, "m/s2; default: -9.81 along the last axis"));
+                      vector_rule(config.dimension, rule));
+  // About a thousand g: beyond any drop or impact test, and small enough that the energies of
+  // a scene (positions within ±1e6 m, speeds within ±1e4 m/s, at most 1e4 s) stay finite.
+  constexpr double most_gravity = 1e4;
+  for (const double x : g) {
+    if (!(std::abs(x) <= most_gravity)) {
+      section.fail_at(
+          "gravity", fmt::format("{} is out of range; allowed: {} with each number within ±{:g}", x,
+                                 vector_rule(config.dimension, rule), most_gravity));
+    }
+  }
   std::copy(g.begin(), g.end(), config.gravity.begin());
 }
 

@@ -3,8 +3,10 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <cmath>
 #include <cstdint>
 #include <sstream>
+#include <stdexcept>
 #include <string_view>
 
 #include "millsim/io/partial_file.hpp"
@@ -265,7 +267,22 @@ std::string summary_json(const MillResult& r) {
       {c.dimension == 2 ? "discs" : "balls", discs},
   };
   if (c.reference) summary.insert("reference", toml::table{{"case", c.reference->case_name}});
-  for (const SummaryNumber& n : summary_numbers(r)) insert_number(summary, n);
+  // JSON has no infinity or NaN: a run whose figures are not finite has diverged, and is
+  // reported as failed rather than written.
+  for (const SummaryNumber& n : summary_numbers(r)) {
+    if (!std::isfinite(n.value)) {
+      throw std::runtime_error(
+          fmt::format("the run diverged: {} is {} (no results written)", n.name, n.value));
+    }
+    insert_number(summary, n);
+  }
+  for (const double x : {r.charge_centre[0], r.charge_centre[1]}) {
+    if (!std::isfinite(x)) {
+      throw std::runtime_error(
+          "the run diverged: charge_centre_of_mass_m is not finite (no "
+          "results written)");
+    }
+  }
   std::ostringstream text;
   text << toml::json_formatter{summary} << "\n";
   return text.str();
@@ -285,12 +302,13 @@ std::string summary_line(const MillResult& r) {
 }
 
 void write_results(const std::filesystem::path& directory, const MillResult& result) {
+  const std::string summary = summary_json(result);  // checked before any file is written
   write_whole_file(directory / "power.csv", power_table(result.revolutions, true));
   write_whole_file(directory / "power_timeseries.csv", power_table(result.series, false));
   write_whole_file(directory / "spectrum.csv", spectrum_table(result));
   write_whole_file(directory / "charge_profile.csv", charge_profile_table(result));
   write_whole_file(directory / "impacts.csv", impacts_table(result));
-  write_whole_file(directory / "summary.json", summary_json(result));
+  write_whole_file(directory / "summary.json", summary);
 }
 
 }  // namespace millsim

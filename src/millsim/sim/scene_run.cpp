@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 
 #include "millsim/core/constants.hpp"
 #include "millsim/core/error.hpp"
@@ -96,7 +97,15 @@ std::string summary_json(const SceneResult& r) {
   const auto add = [&](std::string_view key, const std::string& value, bool last = false) {
     json += fmt::format("  \"{}\": {}{}\n", key, value, last ? "" : ",");
   };
-  const auto number = [](double x) { return fmt::format("{:.17g}", x); };
+  // JSON has no infinity or NaN: a run whose figures are not finite has diverged, and is
+  // reported as failed rather than written.
+  const auto number = [](double x) {
+    if (!std::isfinite(x)) {
+      throw std::runtime_error(fmt::format(
+          "the run diverged: a figure of its summary is {} (summary.json not written)", x));
+    }
+    return fmt::format("{:.17g}", x);
+  };
   add("kind", "\"scene\"");
   add("config", fmt::format("\"{}\"", c.source));
   add("dimension", fmt::format("{}", c.dimension));
@@ -259,10 +268,11 @@ SceneResult run_scene_in(const ScenePlan& plan, const std::filesystem::path& dir
   result.ball_ball_collisions = spectrum.total_count(ContactType::ball_ball);
   result.ball_wall_collisions = spectrum.total_count(ContactType::ball_plane);
 
+  const std::string summary_text = summary_json(result);  // throws before anything is kept
   trajectory.commit();
   final_state.commit();
   PartialFile summary(directory / "summary.json");
-  summary.write(summary_json(result));
+  summary.write(summary_text);
   summary.commit();
   return result;
 }
