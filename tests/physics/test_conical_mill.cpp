@@ -538,7 +538,7 @@ TEST(ConicalMillConfig, BadConesAreRefusedNamingTheKey) {
   expect_has(error_of(replaced(base, "cone_length = 0.1", "cone_length = \"long\"")),
              {"conical.toml:12", "mill.cone_length"});
   expect_has(error_of(replaced(base, "length = 0.15", "length = 0.04")),
-             {"mill.length", "shorter than the largest ball"});
+             {"mill.length", "too short for balls", "at least 1.1 largest ball diameters"});
 }
 
 // ---- A running conical mill --------------------------------------------------------------------

@@ -113,7 +113,8 @@ void read_simulation(TableReader section, MillConfig& config) {
   }
   config.measure_revolutions = static_cast<int>(measure);
   config.seed = static_cast<std::uint64_t>(
-      section.integer("seed", 1, "a whole number >= 0", [](long s) { return s >= 0; }));
+      section.integer("seed", 1, "a whole number from 0 to 9223372036854775807 (2^63 - 1)",
+                      [](long s) { return s >= 0; }));
 }
 
 void read_lifters(TableReader lifters, MillConfig& config) {

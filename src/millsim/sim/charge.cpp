@@ -102,12 +102,14 @@ MillPlan plan_mill(const MillConfig& config) {
         config.location_of("mill.slab_length"), config.slab_length, plan.largest_ball,
         3.0 * plan.largest_ball));
   }
-  if (config.dimension == 3 && !config.periodic && config.length < plan.largest_ball) {
-    // A ball then fits nowhere, and could touch both ends at once.
+  if (config.dimension == 3 && !config.periodic && config.length < 1.1 * plan.largest_ball) {
+    // Shorter, a ball could touch both ends at once, and the placement, which keeps each ball
+    // 2 % of its radius clear of the walls, would find almost no room between them.
     throw InputError(fmt::format(
-        "{}: mill.length: {} m is shorter than the largest ball, {} m; allowed: a 3D mill at "
-        "least one ball diameter long",
-        config.location_of("mill.length"), config.length, plan.largest_ball));
+        "{}: mill.length: {} m is too short for balls of {} m; allowed: a 3D whole mill at least "
+        "1.1 largest ball diameters long, {:.4g} m",
+        config.location_of("mill.length"), config.length, plan.largest_ball,
+        1.1 * plan.largest_ball));
   }
   const double cross_section = pi * plan.radius * plan.radius;
   double bed_volume = config.filling * cross_section * config.length;
@@ -337,9 +339,10 @@ World<D> build_mill_world(const MillPlan& plan) {
       if (!placed) {
         throw InputError(fmt::format(
             "{}: charge.filling: could not place {} {} of {} m without overlap in the mill "
-            "(placed {}); lower the filling or use smaller balls",
+            "(placed {}); lower the filling or use smaller balls{}",
             config.location_of("charge.filling"), plan.particle_count, D == 2 ? "discs" : "balls",
-            c.diameter, particles.size()));
+            c.diameter, particles.size(),
+            D == 3 && !config.periodic ? ", or make the mill longer (mill.length)" : ""));
       }
     }
   }
