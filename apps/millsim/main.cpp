@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <omp.h>
+#include <stdlib.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -122,21 +123,41 @@ void prepare_output_directory(const std::filesystem::path& out, const std::strin
                     "directory path",
                     location, out.string()));
   }
+  // The first of its parents that does not exist yet: what this call makes, and removes again
+  // if the directory turns out to take no files.
+  std::filesystem::path made;
+  for (std::filesystem::path p = out; !p.empty() && !std::filesystem::exists(p);
+       p = p.parent_path()) {
+    made = p;
+    if (p == p.parent_path()) break;
+  }
   try {
     std::filesystem::create_directories(out);
   } catch (const std::filesystem::filesystem_error& error) {
     throw refuse("make", error.code().message());
   }
-  // A file written and removed: a directory that exists but takes no files (read-only, full,
-  // immutable) is found now, not when the results are written at the end.
-  const std::filesystem::path probe = out / ".millsim-write-check";
-  std::FILE* file = std::fopen(probe.c_str(), "w");
-  if (file == nullptr) throw refuse("write in", std::strerror(errno));
-  const bool written = std::fputs("millsim\n", file) >= 0;
-  const bool closed = std::fclose(file) == 0;
-  std::error_code ignored;
-  std::filesystem::remove(probe, ignored);
-  if (!written || !closed) throw refuse("write in", "a test file could not be written");
+  // A file of its own (mkstemp: no file of the user's is touched) written and removed: a
+  // directory that exists but takes no files (read-only, full, immutable) is found now, not
+  // when the results are written at the end.
+  std::string probe = (out / ".millsim-write-check-XXXXXX").string();
+  const int descriptor = ::mkstemp(probe.data());
+  bool writes = false;
+  std::string why;
+  if (descriptor < 0) {
+    why = std::strerror(errno);
+  } else {
+    std::FILE* file = ::fdopen(descriptor, "w");
+    writes = file != nullptr && std::fputs("millsim\n", file) >= 0;
+    writes = (file != nullptr ? std::fclose(file) == 0 : ::close(descriptor) == 0) && writes;
+    std::error_code ignored;
+    std::filesystem::remove(probe, ignored);
+    if (!writes) why = "a test file could not be written";
+  }
+  if (!writes) {
+    std::error_code ignored;
+    if (!made.empty()) std::filesystem::remove_all(made, ignored);
+    throw refuse("write in", why);
+  }
   try {
     for (const char* name : results) std::filesystem::remove(out / name);
     if (snapshots != Snapshots::untouched) std::filesystem::remove_all(out / "snapshots");
@@ -312,9 +333,11 @@ int info_command(const JobOptions& options) {
 /// `--set output.directory` there would be ignored, so it is refused.
 void refuse_output_directory_set(const JobOptions& options, const char* command) {
   for (const std::string& setting : options.overrides) {
+    // Trimmed as the config reader trims a --set key (io/toml_reader.cpp).
+    constexpr const char* blank = " \t\r\n";
     std::string key = setting.substr(0, setting.find('='));
-    key.erase(0, key.find_first_not_of(" \t"));
-    key.erase(key.find_last_not_of(" \t") + 1);
+    key.erase(0, key.find_first_not_of(blank));
+    key.erase(key.find_last_not_of(blank) + 1);
     if (key == "output.directory") {
       throw millsim::InputError(fmt::format(
           "command line (--set {}): output.directory: {} writes each run to a directory of its "
@@ -361,7 +384,21 @@ int validate_command(const std::string& directory, const JobOptions& options) {
           path.string()));
     }
     config.output_directory = (root / path.stem()).string();
-    plans.push_back(millsim::plan_mill(config));
+    const std::filesystem::path out = config.output_directory;
+    if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
+      throw millsim::InputError(
+          fmt::format("{}: output.directory: \"{}\" exists and is not a directory; allowed: a "
+                      "directory path",
+                      root_location, out.string()));
+    }
+    MillPlan plan = millsim::plan_mill(config);
+    // The charge placed as run places it (as info does), so that a filling the mill cannot
+    // hold refuses the validation before any case runs.
+    if (static_cast<double>(plan.particle_count) <= most_placed_by_info) {
+      if (plan.config.dimension == 2) (void)millsim::build_mill_world<2>(plan);
+      if (plan.config.dimension == 3) (void)millsim::build_mill_world<3>(plan);
+    }
+    plans.push_back(std::move(plan));
   }
   struct Row {
     std::string name;

@@ -103,10 +103,15 @@ TEST(Mill, EnergyAccountClosesAndBothPowersAgree) {
   const MillResult r =
       run(lab_mill({"simulation.revolutions=4", "simulation.measure_revolutions=3"}));
   testing::expect_energy_account_closes(r);
-  // The run lasts as long as its plan says (what `info` and the progress line report): the
-  // last step ends the turn within one step of the planned total, spin-up included.
-  EXPECT_NEAR(r.simulated_seconds, r.plan.total_time, r.plan.time_step);
-  EXPECT_NEAR(static_cast<double>(r.steps), r.plan.total_time / r.plan.time_step, 1.0);
+  // The run lasts as long as its plan says (what `info` and the progress line report), spin-up
+  // included: settling ends within half a step of settle_time, and the turn ends on the first
+  // step at or past the last revolution's angle, so within [-0.5, +1.5] steps of the total.
+  const double over = r.simulated_seconds - r.plan.total_time;
+  EXPECT_GE(over, -0.5 * r.plan.time_step);
+  EXPECT_LE(over, 1.5 * r.plan.time_step);
+  const double steps_over = static_cast<double>(r.steps) - r.plan.total_time / r.plan.time_step;
+  EXPECT_GE(steps_over, -0.5);
+  EXPECT_LE(steps_over, 1.5);
 }
 
 }  // namespace

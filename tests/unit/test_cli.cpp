@@ -429,6 +429,15 @@ TEST_F(Cli, AnOutputDirectoryThatTakesNoFilesIsRefusedBeforeTheRun) {
       << o.err;
   EXPECT_NE(o.err.find("allowed: a directory that can be created and written"), std::string::npos)
       << o.err;
+  // A directory the refused run would have made under it is not left behind either.
+  const Outcome below = millsim(std::string("run mill.toml -q --out /proc/self/new ") + tiny_run);
+  EXPECT_EQ(below.status, 2) << below.err;
+  EXPECT_FALSE(fs::exists("/proc/self/new"));
+  // No file of the user's is touched by the check: it writes one of its own name.
+  fs::create_directories(work_ / "mine");
+  std::ofstream(work_ / "mine" / ".millsim-write-check") << "mine\n";
+  ASSERT_EQ(millsim(std::string("run mill.toml -q --out mine ") + tiny_run).status, 0);
+  EXPECT_EQ(read_all(work_ / "mine" / ".millsim-write-check"), "mine\n");
 }
 
 TEST_F(Cli, OutOverridesTheOutputDirectoryOfTheConfigAndOfSetAsAPlainPath) {
@@ -467,6 +476,15 @@ TEST_F(Cli, ValidateReadsEveryCaseBeforeRunningAnyAndShowsAMissingPaperFigureAsN
             std::string::npos)
       << bad.err;
   EXPECT_EQ(bad.err.find("running"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(work_ / "runs"));
+  // A filling the plan accepts but the mill cannot hold (placement fails): refused before any
+  // case runs, as info refuses it.
+  std::ofstream(work_ / "cases" / "b.toml") << with(
+      validation_case("case = \"b\"\nmeasured_power_kw = 0.6\n"), "filling", "filling = 0.7");
+  const Outcome crowded = millsim(std::string("validate cases -o runs ") + tiny_run);
+  EXPECT_EQ(crowded.status, 2) << crowded.err;
+  EXPECT_NE(crowded.err.find("charge.filling: could not place"), std::string::npos) << crowded.err;
+  EXPECT_EQ(crowded.err.find("running"), std::string::npos) << crowded.err;
   EXPECT_FALSE(fs::exists(work_ / "runs"));
   // A case without [reference]: refused by name before any runs.
   std::ofstream(work_ / "cases" / "b.toml") << base_config;
@@ -510,6 +528,11 @@ TEST_F(Cli, ValidateReadsEveryCaseBeforeRunningAnyAndShowsAMissingPaperFigureAsN
       << set.err;
   EXPECT_FALSE(fs::exists(work_ / "runs2"));
   EXPECT_FALSE(fs::exists(work_ / "elsewhere"));
+  // The key as the config reader reads it, blanks (a carriage return too) trimmed.
+  const Outcome blank = millsim(std::string("validate cases -q -o runs2 ") + tiny_run +
+                                " --set \"$(printf 'output.directory\\r=elsewhere')\"");
+  EXPECT_EQ(blank.status, 2) << blank.err;
+  EXPECT_FALSE(fs::exists(work_ / "runs2"));
 }
 
 }  // namespace

@@ -613,15 +613,17 @@ template <int D>
 std::size_t World<D>::list_pairs_for_law(std::size_t begin, std::size_t end, std::size_t below,
                                          std::uint32_t* listed) const {
   // Four loops, so that each pair costs only the instructions its world needs (the loop is
-  // bound by their number: about 37 a pair, five a cycle, in the 3D 20 k scene before), and in
-  // 3D with AVX2 a fifth that takes four pairs at a time.
+  // bound by their number: about 37 a pair, five a cycle, in the 3D 20 k scene before), and with
+  // AVX2 a fifth that takes four pairs at a time: in 3D worlds that are not periodic, and in 2D
+  // worlds small enough for the caches (a larger one keeps the one-by-one loop, which fetches
+  // the position of the pair 64 ahead's second particle; bench/results.md).
   const bool every_pair = below >= particles_.size();
   std::size_t count = 0;
   if (neighbours_.period() > 0.0) {
     count = every_pair ? list_pairs_of<true, true>(begin, end, below, listed)
                        : list_pairs_of<true, false>(begin, end, below, listed);
 #if defined(__x86_64__)
-  } else if (every_pair && avx2_lanes_) {
+  } else if (every_pair && avx2_lanes_ && (D == 3 || !prefetch_pairs_)) {
     count = list_pairs_avx2(begin, end, listed);
 #endif
   } else {
