@@ -37,6 +37,13 @@ inline constexpr double steps_per_contact = 200.0;
 // rule: the first force sample stands for the step centred on it, which begins at the touch.
 inline constexpr double free_flight_steps = 40.5;
 
+// With tension the contact is the linear damped oscillator, which the leapfrog integrates to
+// second order: over one contact its error in the phase and amplitude is of order
+// (ω_d Δt)² = (π/200)² = 2.5e-4 at t_c/200, where a first-order scheme would be off by about
+// π/200 = 1.6e-2. The with-tension answers are held to 1e-3 (relative) besides the issue's
+// 1 % and 2 %; measured: within 1.1e-4 (e) and 6e-5 (t_c).
+inline constexpr double second_order_tolerance = 1e-3;
+
 inline void record(const std::string& key, double value) {
   ::testing::Test::RecordProperty(key, fmt::format("{:.6g}", value));
 }

@@ -148,8 +148,31 @@ TEST(Config, ReadsTheShippedExample) {
   const std::string path = std::string(MILLSIM_SOURCE_DIR) + "/examples/lab-mill-2d.toml";
   const MillConfig c = load_mill_config(path);
   EXPECT_EQ(c.source, path);
-  EXPECT_GT(c.diameter, 0.0);
-  EXPECT_FALSE(c.sizes.empty());
+  // The file's values (examples/lab-mill-2d.toml: case 3D-g's mill as a 2D slice).
+  EXPECT_EQ(c.dimension, 2);
+  EXPECT_FALSE(c.time_step.has_value()) << "auto";
+  EXPECT_EQ(c.settle_time, 1.0);
+  EXPECT_EQ(c.revolutions, 6);
+  EXPECT_EQ(c.measure_revolutions, 4);
+  EXPECT_EQ(c.seed, 1u);
+  EXPECT_EQ(c.diameter, 0.9);
+  EXPECT_EQ(c.length, 0.15);
+  EXPECT_EQ(c.speed_fraction.value_or(-1.0), 0.5);
+  EXPECT_EQ(c.lifter_count, 8);
+  EXPECT_EQ(c.lifter_height, 0.04);
+  EXPECT_EQ(c.lifter_width, 0.04);
+  EXPECT_EQ(c.filling, 0.30);
+  EXPECT_EQ(c.porosity, 0.4);
+  EXPECT_EQ(c.density, 7800.0);
+  ASSERT_EQ(c.sizes.size(), 1u);
+  EXPECT_EQ(c.sizes[0].diameter, 0.0508);
+  EXPECT_EQ(c.sizes[0].mass_fraction, 1.0);
+  EXPECT_EQ(c.ball_ball.normal_stiffness, 4.0e5);
+  EXPECT_EQ(c.ball_ball.tangential_stiffness, 3.0e5);
+  EXPECT_EQ(c.ball_ball.restitution, 0.6);
+  EXPECT_EQ(c.ball_ball.friction, 0.5);
+  EXPECT_EQ(c.ball_wall.normal_stiffness, 4.0e5);
+  EXPECT_EQ(c.ball_wall.restitution, 0.6);
 }
 
 TEST(Config, AcceptsAnIntegerWhereANumberIsExpected) {

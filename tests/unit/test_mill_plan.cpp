@@ -60,6 +60,18 @@ TEST(MillPlan, CriticalSpeedAndSpeedFromAFractionOfIt) {
   EXPECT_HAND(plan.total_time, 17.012954);
 }
 
+TEST(MillPlan, CriticalSpeedUsesTheLargestBallWhereverItIsListed) {
+  // MODEL.md §1: N_c with d the largest ball. Sizes listed smallest first, 3 cm and 6 cm:
+  // D − d = 0.9 − 0.06 = 0.84 m, 2g/(D − d) = 23.357143 s⁻², sqrt = 4.8329228 s⁻¹,
+  // × 60/(2π) = 46.151013 rpm.
+  MillConfig config = lab_mill();
+  config.sizes = {{0.03, 0.5}, {0.06, 0.5}};
+  const MillPlan plan = plan_mill(config);
+  EXPECT_EQ(plan.largest_ball, 0.06);
+  EXPECT_HAND(plan.critical_speed_rpm, 46.151013);
+  EXPECT_HAND(plan.speed_rpm, 0.5 * 46.151013);
+}
+
 TEST(MillPlan, SpeedGivenInRpm) {
   MillConfig config = lab_mill();
   config.speed_fraction.reset();

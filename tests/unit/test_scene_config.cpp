@@ -108,6 +108,11 @@ TEST(SceneConfig, AutoTimeStepIsATwentiethOfTheShortestContact) {
   std::string text(drop);
   text.replace(text.find("time_step = 1e-6"), 16, "time_step = \"auto\"");
   const millsim::ScenePlan plan = millsim::plan_scene(scene(text));
+  // By hand: one sphere of 4000 kg/m³ and 0.02 m, m = 4000 π/6 0.02³ = 0.016755161 kg, on a wall
+  // (m* = m) of k_n = 1e6 N/m and the default e = 0.6: ζ = −ln 0.6 / sqrt(ln² 0.6 + π²) =
+  // 0.16049305, ω_0 = sqrt(k_n/m) = 7725.5 s⁻¹, t_c = π / (ω_0 sqrt(1 − ζ²)) = 4.1199387e-4 s.
+  EXPECT_NEAR(plan.shortest_contact, 4.1199387e-4, 1e-11);
+  EXPECT_NEAR(plan.time_step, 2.0599693e-5, 1e-12);
   EXPECT_DOUBLE_EQ(plan.time_step, plan.shortest_contact / 20.0);
   EXPECT_LT(plan.time_step, plan.critical_time_step);
 }

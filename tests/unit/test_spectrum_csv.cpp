@@ -85,6 +85,10 @@ TEST(SpectrumCsv, EachCollisionIsInItsBinWithRatesAndCumulativeEnergies) {
   EXPECT_NEAR(high.at("ball_wall_energy_j"), 0.5, 1e-9);
   EXPECT_NEAR(high.at("ball_wall_cumulative_energy_j"), 0.5 + 2.0e-8, 1e-6);  // 6 digits
   EXPECT_EQ(row_of(2.0e-8).at("ball_lifter_count"), 1.0);
+  // The lifter's collision in ball_wall's own row (the cumulative figure above cannot show a
+  // 2e-8 J term at 6 digits).
+  EXPECT_EQ(row_of(2.0e-8).at("ball_wall_count"), 1.0);
+  EXPECT_NEAR(row_of(2.0e-8).at("ball_wall_energy_j"), 2.0e-8, 1e-13);
   // The last row's cumulative energy is the total of its type.
   EXPECT_NEAR(rows.back().at("ball_ball_cumulative_energy_j"),
               s.total_energy(ContactType::ball_ball), 1e-12);
