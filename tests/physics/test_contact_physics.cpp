@@ -68,12 +68,12 @@ MeasuredImpact measure_impact(World<2>& world, Overlap overlap, SeparationSpeed 
           static_cast<double>(force_steps) * dt, final_energy / initial_energy - 1.0};
 }
 
-/// Two discs of masses m_a, m_b meet head on along x at approach_speed, total momentum zero.
-MeasuredImpact disc_disc_impact(const ContactMaterial& material, double mass_a, double mass_b,
-                                bool allow_tension) {
-  const double effective_mass = reduced_mass(mass_a, mass_b);
+/// Two discs of masses m_a, m_b about to meet head on along x at approach_speed, total momentum
+/// zero, the touch half-way between two steps (free_flight_steps).
+World<2> disc_disc_world(const ContactMaterial& material, double mass_a, double mass_b,
+                         bool allow_tension) {
   WorldSettings<2> settings;
-  settings.time_step = contact_duration(material, effective_mass) / steps_per_contact;
+  settings.time_step = contact_duration(material, reduced_mass(mass_a, mass_b)) / steps_per_contact;
   settings.ball_ball = material;
   settings.allow_tension = allow_tension;
   World<2> world(settings, Walls<2>{});
@@ -83,24 +83,17 @@ MeasuredImpact disc_disc_impact(const ContactMaterial& material, double mass_a, 
                         Vec2{{approach_speed * mass_b / total_mass, 0.0}});
   world.particles().add(Vec2{{2.0 * disc_radius + gap, 0.0}}, disc_radius, mass_b,
                         Vec2{{-approach_speed * mass_a / total_mass, 0.0}});
-  const MeasuredImpact measured = measure_impact(
-      world,
-      [](const World<2>& w) {
-        const auto& x = w.particles().position;
-        return 2.0 * disc_radius - norm(x[1] - x[0]);
-      },
-      [](const World<2>& w) {
-        const auto& v = w.particles().velocity;
-        return v[1][0] - v[0][0];
-      });
-  const auto& v = world.particles().velocity;
-  EXPECT_NEAR(mass_a * v[0][0] + mass_b * v[1][0], 0.0, 1e-12 * total_mass * approach_speed)
-      << "momentum";
-  return measured;
+  return world;
 }
 
-/// A disc falls on the floor plane y = 0 at approach_speed, without gravity: m* = m.
-MeasuredImpact disc_wall_impact(const ContactMaterial& material, double mass, bool allow_tension) {
+/// The overlap of disc_disc_world's two discs.
+double disc_disc_overlap(const World<2>& w) {
+  const auto& x = w.particles().position;
+  return 2.0 * disc_radius - norm(x[1] - x[0]);
+}
+
+/// A disc about to fall on the floor plane y = 0 at approach_speed, without gravity: m* = m.
+World<2> disc_wall_world(const ContactMaterial& material, double mass, bool allow_tension) {
   WorldSettings<2> settings;
   settings.time_step = contact_duration(material, mass) / steps_per_contact;
   settings.ball_wall = material;
@@ -111,9 +104,34 @@ MeasuredImpact disc_wall_impact(const ContactMaterial& material, double mass, bo
   const double gap = free_flight_steps * settings.time_step * approach_speed;
   world.particles().add(Vec2{{0.0, disc_radius + gap}}, disc_radius, mass,
                         Vec2{{0.0, -approach_speed}});
-  return measure_impact(
-      world, [](const World<2>& w) { return disc_radius - w.particles().position[0][1]; },
-      [](const World<2>& w) { return w.particles().velocity[0][1]; });
+  return world;
+}
+
+/// The overlap of disc_wall_world's disc with the floor.
+double disc_wall_overlap(const World<2>& w) {
+  return disc_radius - w.particles().position[0][1];
+}
+
+/// Two discs of masses m_a, m_b meet head on along x at approach_speed, total momentum zero.
+MeasuredImpact disc_disc_impact(const ContactMaterial& material, double mass_a, double mass_b,
+                                bool allow_tension) {
+  World<2> world = disc_disc_world(material, mass_a, mass_b, allow_tension);
+  const double total_mass = mass_a + mass_b;
+  const MeasuredImpact measured = measure_impact(world, disc_disc_overlap, [](const World<2>& w) {
+    const auto& v = w.particles().velocity;
+    return v[1][0] - v[0][0];
+  });
+  const auto& v = world.particles().velocity;
+  EXPECT_NEAR(mass_a * v[0][0] + mass_b * v[1][0], 0.0, 1e-12 * total_mass * approach_speed)
+      << "momentum";
+  return measured;
+}
+
+/// A disc falls on the floor plane y = 0 at approach_speed, without gravity: m* = m.
+MeasuredImpact disc_wall_impact(const ContactMaterial& material, double mass, bool allow_tension) {
+  World<2> world = disc_wall_world(material, mass, allow_tension);
+  return measure_impact(world, disc_wall_overlap,
+                        [](const World<2>& w) { return w.particles().velocity[0][1]; });
 }
 
 // The energy account of one impact closes. With tension its error is O(Δt²), 2e-4 of the
@@ -267,39 +285,12 @@ TEST(ImpactSpectrumOfOneCollision, HeadOnDiscsAndDiscOnWallAreOneRecordOfTheEner
   for (const double e : {0.2, 0.5, 0.8}) {
     SCOPED_TRACE(fmt::format("e = {}", e));
     const ContactMaterial material = material_with(e);
-    {
-      const double m_a = 1.0, m_b = 3.0;
-      const double effective_mass = reduced_mass(m_a, m_b);
-      WorldSettings<2> settings;
-      settings.time_step = contact_duration(material, effective_mass) / steps_per_contact;
-      settings.ball_ball = material;
-      World<2> world(settings, Walls<2>{});
-      const double gap = free_flight_steps * settings.time_step * approach_speed;
-      world.particles().add(Vec2{{0.0, 0.0}}, disc_radius, m_a,
-                            Vec2{{approach_speed * m_b / (m_a + m_b), 0.0}});
-      world.particles().add(Vec2{{2.0 * disc_radius + gap, 0.0}}, disc_radius, m_b,
-                            Vec2{{-approach_speed * m_a / (m_a + m_b), 0.0}});
-      expect_one_record_of_the_impact(world, ContactType::ball_ball, effective_mass, material,
-                                      [](const World<2>& w) {
-                                        const auto& x = w.particles().position;
-                                        return 2.0 * disc_radius - norm(x[1] - x[0]);
-                                      });
-    }
-    {
-      const double mass = 2.0;
-      WorldSettings<2> settings;
-      settings.time_step = contact_duration(material, mass) / steps_per_contact;
-      settings.ball_wall = material;
-      Walls<2> walls;
-      walls.planes.push_back(Plane<2>{Vec2{{0.0, 0.0}}, Vec2{{0.0, 1.0}}});
-      World<2> world(settings, walls);
-      const double gap = free_flight_steps * settings.time_step * approach_speed;
-      world.particles().add(Vec2{{0.0, disc_radius + gap}}, disc_radius, mass,
-                            Vec2{{0.0, -approach_speed}});
-      expect_one_record_of_the_impact(
-          world, ContactType::ball_plane, mass, material,
-          [](const World<2>& w) { return disc_radius - w.particles().position[0][1]; });
-    }
+    World<2> pair = disc_disc_world(material, 1.0, 3.0, false);
+    expect_one_record_of_the_impact(pair, ContactType::ball_ball, reduced_mass(1.0, 3.0), material,
+                                    disc_disc_overlap);
+    World<2> drop = disc_wall_world(material, 2.0, false);
+    expect_one_record_of_the_impact(drop, ContactType::ball_plane, 2.0, material,
+                                    disc_wall_overlap);
   }
 }
 
