@@ -17,7 +17,12 @@ out=${2:-runs/bench/sag-12m-2d}
 shift $(( $# < 2 ? $# : 2 ))
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'), $threads thread(s)"
 ./build/release/millsim run -q -j "$threads" bench/sag-12m-2d.toml --out "$out" "$@"
-# Real-time factor: simulated mill seconds (settling included) per wall second.
-awk -F'[:,]' '/"simulated_seconds"/ {s = $2} /"wall_seconds"/ {w = $2}
-  END {printf "simulated %.2f s in %.1f s of wall time: real-time factor %.3f\n", s, w, s / w}' \
+# Real-time factor: simulated mill seconds (settling included) per wall second; and the same for
+# the turning alone (after settling: the spin-up and the revolutions).
+settle=$(awk -F'= *' '/^settle_time/ {print $2}' bench/sag-12m-2d.toml)
+awk -F'[:,]' -v settle="$settle" \
+  '/"simulated_seconds"/ {s = $2} /"wall_seconds"/ {w = $2} /"settle_wall_seconds"/ {ws = $2}
+  END {printf "simulated %.2f s in %.1f s of wall time: real-time factor %.3f\n", s, w, s / w
+       printf "turning (after %.2f s of settling in %.1f s): %.2f s in %.1f s, real-time factor %.3f\n",
+              settle, ws, s - settle, w - ws, (s - settle) / (w - ws)}' \
   "$out/summary.json"

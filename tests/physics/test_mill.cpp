@@ -112,6 +112,9 @@ TEST(Mill, EnergyAccountClosesAndBothPowersAgree) {
   const double steps_over = static_cast<double>(r.steps) - r.plan.total_time / r.plan.time_step;
   EXPECT_GE(steps_over, -0.5);
   EXPECT_LE(steps_over, 1.5);
+  // The settling's share of the wall time is part of it.
+  EXPECT_GT(r.settle_wall_seconds, 0.0);
+  EXPECT_LT(r.settle_wall_seconds, r.wall_seconds);
 }
 
 }  // namespace

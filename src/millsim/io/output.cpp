@@ -167,6 +167,7 @@ std::vector<SummaryNumber> summary_numbers(const MillResult& r) {
       {"steps", count(r.steps), true},
       {"simulated_seconds", r.simulated_seconds},
       {"wall_seconds", r.wall_seconds},
+      {"settle_wall_seconds", r.settle_wall_seconds},
       {"particle_steps_per_second", r.particle_steps_per_second},
       {"measured_revolutions", count(c.measure_revolutions), true},
       {"slice_charge_mass_kg", plan.slice_mass},

@@ -91,6 +91,8 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
     if (progress && world.steps() % 2000 == 0) progress(world.time(), plan.total_time, 0.0);
   }
   result.settled_kinetic_energy = world.kinetic_energy();
+  result.settle_wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
   // Turn: ω ramps up linearly over spin_up_time, then stays. Revolutions are counted by the
   // angle the shell has turned.

@@ -49,6 +49,7 @@ struct MillResult {
   long steps = 0;
   double simulated_seconds = 0.0;
   double wall_seconds = 0.0;
+  double settle_wall_seconds = 0.0;  ///< s of wall_seconds spent settling, before the shell turns
   double particle_steps_per_second = 0.0;
   double settled_kinetic_energy = 0.0;  ///< J, slice, at the end of settling
   /// Centre of mass of the charge in the cross-section (x, y) averaged over the measured
