@@ -24,6 +24,7 @@
 
 #include "millsim/builtin_example.hpp"
 #include "millsim/core/error.hpp"
+#include "millsim/core/version.hpp"
 #include "millsim/io/config.hpp"
 #include "millsim/io/output.hpp"
 #include "millsim/measure/empirical_power.hpp"
@@ -575,6 +576,8 @@ void add_job_options(CLI::App& command, JobOptions& options) {
 int main(int argc, char** argv) {
   CLI::App app{"millsim: discrete element simulation of tumbling mills"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", "millsim " + millsim::version_text(),
+                       "print the version and the source revision, and exit");
   JobOptions options;
   std::string validation_directory = "examples/validation";
 
@@ -615,7 +618,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
-    if (error.get_exit_code() == 0) return app.exit(error);  // --help
+    if (error.get_exit_code() == 0) return app.exit(error);  // --help, --version
     if (argc > 1 && argv[1][0] != '-' && app.get_subcommands().empty()) {
       // CLI11 would say only that a command is required.
       fmt::print(stderr,

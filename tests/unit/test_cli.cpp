@@ -16,6 +16,7 @@
 #include <string_view>
 #include <vector>
 
+#include "millsim/core/version.hpp"
 #include "support/program_test.hpp"
 
 namespace {
@@ -132,6 +133,18 @@ TEST_F(Cli, ATinyRunOfTheBaseConfigWritesItsResults) {
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_TRUE(fs::exists(work_ / "out" / "summary.json"));
   EXPECT_NE(o.out.find("power"), std::string::npos) << o.out;
+  // The summary names the program that made it, as --version does.
+  EXPECT_NE(read_all(work_ / "out" / "summary.json")
+                .find("\"millsim_version\" : \"" + millsim::version_text() + "\""),
+            std::string::npos)
+      << read_all(work_ / "out" / "summary.json");
+}
+
+TEST_F(Cli, VersionPrintsTheVersionAndTheSourceRevision) {
+  const Outcome o = millsim("--version");
+  EXPECT_EQ(o.status, 0) << o.err;
+  EXPECT_EQ(o.out, "millsim " + millsim::version_text() + "\n");
+  EXPECT_TRUE(o.out.starts_with("millsim 0.1.0 (")) << o.out;
 }
 
 TEST_F(Cli, RefusesATimeStepAboveTheStabilityLimitAndGivesTheLimit) {

@@ -9,11 +9,13 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <iterator>
 #include <string>
 #include <string_view>
 #include <variant>
 
 #include "millsim/core/error.hpp"
+#include "millsim/core/version.hpp"
 #include "millsim/io/config.hpp"
 #include "millsim/sim/scene_run.hpp"
 
@@ -223,6 +225,12 @@ TEST(SceneRun, WritesTrajectoryFinalAndSummaryAndNothingPartial) {
   int lines = 0;
   for (std::string line; std::getline(trajectory, line);) ++lines;
   EXPECT_EQ(lines, 1002);
+  // The summary names the program that made it.
+  std::ifstream summary(work / "out" / "summary.json");
+  const std::string json((std::istreambuf_iterator<char>(summary)), {});
+  EXPECT_NE(json.find("\"millsim_version\": \"" + millsim::version_text() + "\""),
+            std::string::npos)
+      << json;
 
   // A refused scene writes nothing.
   std::string bad(drop);

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "millsim/core/version.hpp"
 #include "millsim/io/partial_file.hpp"
 #include "millsim/measure/empirical_power.hpp"
 #include "millsim/sim/mill_run.hpp"
@@ -263,6 +264,7 @@ std::string summary_json(const MillResult& r) {
         toml::table{{"diameter_m", d.diameter}, {"count", d.count}, {"mass_kg", d.mass}});
   }
   toml::table summary{
+      {"millsim_version", version_text()},
       {"config", c.source},
       {"charge_centre_of_mass_m", toml::array{r.charge_centre[0], r.charge_centre[1]}},
       {c.dimension == 2 ? "discs" : "balls", discs},

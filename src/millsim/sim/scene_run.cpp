@@ -11,6 +11,7 @@
 
 #include "millsim/core/constants.hpp"
 #include "millsim/core/error.hpp"
+#include "millsim/core/version.hpp"
 #include "millsim/io/partial_file.hpp"
 
 namespace millsim {
@@ -107,6 +108,7 @@ std::string summary_json(const SceneResult& r) {
     return fmt::format("{:.17g}", x);
   };
   add("kind", "\"scene\"");
+  add("millsim_version", fmt::format("\"{}\"", version_text()));
   add("config", fmt::format("\"{}\"", c.source));
   add("dimension", fmt::format("{}", c.dimension));
   add("particle_count", fmt::format("{}", c.particles.size()));
