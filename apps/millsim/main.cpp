@@ -125,10 +125,15 @@ void prepare_output_directory(const std::filesystem::path& out, const std::strin
                     location, out.string()));
   }
   // The first of its parents that does not exist yet: what this call makes, and removes again
-  // if the directory turns out to take no files.
+  // if the directory turns out to take no files. Anything whose state cannot be read (or a
+  // link, even a dangling one) counts as existing: only what is surely absent is ever removed.
   std::filesystem::path made;
-  for (std::filesystem::path p = out; !p.empty() && !std::filesystem::exists(p);
-       p = p.parent_path()) {
+  for (std::filesystem::path p = out; !p.empty(); p = p.parent_path()) {
+    std::error_code error;
+    const std::filesystem::file_status state = std::filesystem::symlink_status(p, error);
+    // (A missing path sets `error` too, with the type not_found; any other error leaves the
+    // type none.)
+    if (state.type() != std::filesystem::file_type::not_found) break;
     made = p;
     if (p == p.parent_path()) break;
   }
