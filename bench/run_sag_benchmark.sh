@@ -19,7 +19,10 @@ echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *
 ./build/release/millsim run -q -j "$threads" bench/sag-12m-2d.toml --out "$out" "$@"
 # Real-time factor: simulated mill seconds (settling included) per wall second; and the same for
 # the turning alone (after settling: the spin-up and the revolutions).
-settle=$(awk -F'= *' '/^settle_time/ {print $2}' bench/sag-12m-2d.toml)
+settle=$(awk -F'= *' '/^settle_time/ {print $2 + 0}' bench/sag-12m-2d.toml)
+for argument in "$@"; do  # a --set of the settling time replaces the file's
+  case "$argument" in simulation.settle_time=*) settle=${argument#simulation.settle_time=} ;; esac
+done
 awk -F'[:,]' -v settle="$settle" \
   '/"simulated_seconds"/ {s = $2} /"wall_seconds"/ {w = $2} /"settle_wall_seconds"/ {ws = $2}
   END {printf "simulated %.2f s in %.1f s of wall time: real-time factor %.3f\n", s, w, s / w

@@ -549,8 +549,8 @@ TEST(ConicalMillConfig, BadConesAreRefusedNamingTheKey) {
 TEST(ConicalMill, ChargeFillsTheConesAndTheEnergyAccountCloses) {
   // A small mill (0.5 m × 0.1 m, six 3 × 3 cm lifters, 25°, 0.06 m cones, 165 balls of 4 cm,
   // 60 % of critical) settled 0.5 s, turned two revolutions, the second measured, at the default
-  // time step (what users run: seen 0.49 %, against the issue's 1 %; 0.12 % at half the step, the
-  // O(Δt) offset of the flat mill's energy test). The settled charge lies inside the mill and
+  // time step (what users run: seen 0.49 %, against the issue's 1 %; 0.12 % at half the step, as
+  // the flat mill's energy test falls with the step). The settled charge lies inside the mill and
   // partly in the cones, the shell's work equals the change of energy plus what is dissipated,
   // and the two powers agree.
   const std::string text = R"([simulation]

@@ -600,9 +600,9 @@ TEST(Mill3D, TumblesBelowCriticalAndCentrifugesAboveIt) {
 TEST(Mill3D, EnergyAccountClosesAndBothPowersAgree) {
   // Case 3D-g, settled 0.6 s, turned three revolutions, measured over the last two, at the
   // default time step (what users run; the bound is 1 %), and at half of it. The account's
-  // error is an O(Δt) offset of the slip's booking (docs/model.md, "Friction"), not noise: at the
-  // default it closes to about 0.6 % (0.60 % and 0.61 % in the 3D validation runs), at half the
-  // step to about a tenth of that, and it must shrink with the step.
+  // error is the integration's, not noise: at the default it closes to 0.60 % here (0.60 % and
+  // 0.61 % in the 3D validation runs), at half the step to 0.057 %, about a tenth; it must at
+  // least halve.
   const MillPlan default_plan = plan_mill(lab_mill_config());
   const std::vector<std::string> run_settings = {
       "simulation.settle_time=0.6", "simulation.revolutions=3", "simulation.measure_revolutions=2"};
