@@ -100,6 +100,17 @@ class ProgressLine {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
+/// Refuses an output directory `out` that exists as something other than a directory;
+/// `location` names where it was given.
+void refuse_a_file_as_directory(const std::filesystem::path& out, const std::string& location) {
+  if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
+    throw millsim::InputError(
+        fmt::format("{}: output.directory: \"{}\" exists and is not a directory; allowed: a "
+                    "directory path",
+                    location, out.string()));
+  }
+}
+
 /// What becomes of an earlier run's snapshots/ subdirectory: left (scenes write none), removed,
 /// or removed and made again empty.
 enum class Snapshots { untouched, removed, made };
@@ -118,12 +129,7 @@ void prepare_output_directory(const std::filesystem::path& out, const std::strin
                     "can be created and written",
                     location, what, out.string(), why));
   };
-  if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
-    throw millsim::InputError(
-        fmt::format("{}: output.directory: \"{}\" exists and is not a directory; allowed: a "
-                    "directory path",
-                    location, out.string()));
-  }
+  refuse_a_file_as_directory(out, location);
   // The first of its parents that does not exist yet: what this call makes, and removes again
   // if the directory turns out to take no files. Anything whose state cannot be read (or a
   // link, even a dangling one) counts as existing: only what is surely absent is ever removed.
@@ -390,13 +396,7 @@ int validate_command(const std::string& directory, const JobOptions& options) {
           path.string()));
     }
     config.output_directory = (root / path.stem()).string();
-    const std::filesystem::path out = config.output_directory;
-    if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
-      throw millsim::InputError(
-          fmt::format("{}: output.directory: \"{}\" exists and is not a directory; allowed: a "
-                      "directory path",
-                      root_location, out.string()));
-    }
+    refuse_a_file_as_directory(config.output_directory, root_location);
     MillPlan plan = millsim::plan_mill(config);
     // The charge placed as run places it (as info does), so that a filling the mill cannot
     // hold refuses the validation before any case runs.
