@@ -510,6 +510,7 @@ std::vector<millsim::SweepRow> run_sweep(const std::vector<MillPlan>& plans,
 /// sweep.csv and prints a table. Exit status 1 if any point failed.
 int sweep_command(const JobOptions& options, const std::vector<std::string>& vary_arguments) {
   std::vector<millsim::SweepAxis> axes;
+  axes.reserve(vary_arguments.size());
   for (const std::string& argument : vary_arguments) axes.push_back(millsim::parse_vary(argument));
   millsim::check_sweep_axes(axes);
   refuse_output_directory_set(options, "sweep");
@@ -576,9 +577,9 @@ void add_job_options(CLI::App& command, JobOptions& options) {
   command.add_flag("-q,--quiet", options.quiet, "print only the one-line summary");
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+/// The program: parses the command line and runs the command. Errors it foresees are reported
+/// here; main catches anything else.
+int run_program(int argc, char** argv) {
   CLI::App app{"millsim: discrete element simulation of tumbling mills"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "millsim " + millsim::version_text(),
@@ -691,4 +692,19 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "millsim: failed: {}\n", error.what());
     return 1;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Anything run_program lets through (an exception from setting up the command line, or from
+  // printing an error) is still a message and exit status 1, not std::terminate's abort.
+  try {
+    return run_program(argc, argv);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "millsim: failed: %s\n", error.what());
+  } catch (...) {
+    std::fputs("millsim: failed: an unknown error\n", stderr);
+  }
+  return 1;
 }

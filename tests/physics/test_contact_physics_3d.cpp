@@ -538,8 +538,10 @@ TEST(EnergyConservation3D, ElasticFrictionlessSpheresInABox) {
     Sphere sphere;
     sphere.radius = 0.02 + 0.02 * random();
     sphere.mass = density * 4.0 / 3.0 * pi * std::pow(sphere.radius, 3);
-    sphere.position = Vec3{{(i % per_row + 0.5) * cell, (i / per_row % per_row + 0.5) * cell,
-                            (i / (per_row * per_row) + 0.5) * cell}};
+    const int column = i % per_row;  // the sphere's place in the cube of per_row³
+    const int row = i / per_row % per_row;
+    const int layer = i / (per_row * per_row);
+    sphere.position = Vec3{{(column + 0.5) * cell, (row + 0.5) * cell, (layer + 0.5) * cell}};
     sphere.velocity = random() * random_direction(random);
     smallest_mass = std::min(smallest_mass, sphere.mass);
     spheres.push_back(sphere);

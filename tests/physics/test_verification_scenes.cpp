@@ -83,7 +83,7 @@ class VerificationScene : public ::testing::Test {
 
   /// Runs `millsim run examples/verification/NAME.toml EXTRA` and returns its output directory.
   fs::path run(const std::string& name, const std::string& extra = {}) {
-    const fs::path out = root_ / name;
+    fs::path out = root_ / name;
     const std::string command = std::string("\"") + MILLSIM_BINARY + "\" run -q \"" +
                                 MILLSIM_SOURCE_DIR + "/examples/verification/" + name +
                                 ".toml\" --out \"" + out.string() + "\" " + extra +

@@ -28,7 +28,8 @@ struct Charge {
   std::vector<Vec2> position;
   std::vector<double> radius;
   void arc(double toe, double shoulder, double rho) {
-    for (double a = toe + 0.5; a < shoulder + 360.0; a += 1.0) {
+    for (int k = 0; toe + 0.5 + k < shoulder + 360.0; ++k) {
+      const double a = toe + 0.5 + k;
       position.push_back(at(rho, a * degree));
       radius.push_back(ball);
     }

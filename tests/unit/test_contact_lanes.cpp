@@ -7,8 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <bit>
 #include <cmath>
-#include <cstring>
+#include <cstdint>
 #include <random>
 
 #include "millsim/contact/linear_spring_dashpot.hpp"
@@ -21,7 +22,7 @@ constexpr auto lanes = static_cast<std::size_t>(lane_count);
 
 /// Whether two doubles have the same bits (+0 and −0 differ, as they may not for ==).
 bool same_bits(double a, double b) {
-  return std::memcmp(&a, &b, sizeof a) == 0;
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
 }
 
 template <int D>

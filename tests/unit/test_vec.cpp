@@ -1,7 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
-#include <cstring>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <vector>
@@ -62,7 +63,7 @@ TEST(Vec, NearestIntegerHasTheBitsOfNearbyint) {
   for (const double t : values) {
     const double expected = std::nearbyint(t);
     const double got = nearest_integer(t);
-    EXPECT_EQ(std::memcmp(&expected, &got, sizeof got), 0)
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(expected), std::bit_cast<std::uint64_t>(got))
         << "t = " << t << ": nearbyint " << expected << ", nearest_integer " << got;
   }
   EXPECT_TRUE(std::isnan(nearest_integer(std::numeric_limits<double>::quiet_NaN())));

@@ -255,7 +255,7 @@ NearbyLifters nearby_lifters(const Mill2D& mill, const Vec2& planar_centre, doub
   const double across = (0.5 * mill.lifter_width + reach) / closest;
   if (across >= 1.0) return nearby;
   const double spacing = 2.0 * pi / lifters;
-  const int window = static_cast<int>(std::asin(across) / spacing + 0.5) + 1;
+  const int window = static_cast<int>(std::lround(std::asin(across) / spacing)) + 1;
   if (2 * window + 1 >= lifters) return nearby;
   const double relative = approximate_atan2(planar_centre[1], planar_centre[0]) - mill.angle;
   const double turns = relative / spacing;

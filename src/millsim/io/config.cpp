@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <utility>
 
 #include "millsim/core/constants.hpp"
 #include "millsim/core/error.hpp"
@@ -647,14 +648,16 @@ SceneConfig read_scene_config(const toml::table& document, const std::string& so
       "velocity, angular_velocity, density, material",
       d == 2 ? "[x, y]" : "[x, y, z]");
   if (!root.has("particles")) root.fail_missing("particles", particle_rule);
-  read_table_array(root, "particles", particle_rule, &config.key_locations,
-                   [&](TableReader p) { config.particles.push_back(read_scene_particle(p, d)); });
+  read_table_array(root, "particles", particle_rule, &config.key_locations, [&](TableReader p) {
+    config.particles.push_back(read_scene_particle(std::move(p), d));
+  });
   if (config.particles.empty()) {
     root.fail_at("particles", fmt::format("no particles; allowed: {}", particle_rule));
   }
   read_table_array(
       root, "walls", "an array of tables [[walls]], each with point and normal (infinite planes)",
-      &config.key_locations, [&](TableReader w) { config.walls.push_back(read_scene_wall(w, d)); });
+      &config.key_locations,
+      [&](TableReader w) { config.walls.push_back(read_scene_wall(std::move(w), d)); });
   TableReader materials = root.table("materials", false);
   materials.allow_keys({"ball_ball", "ball_wall"});
   config.ball_ball = read_material(materials.table("ball_ball", false));

@@ -454,9 +454,8 @@ void apply_overrides(toml::table& document, const std::vector<std::string>& over
       }
       table = next->as_table();
     }
-    parsed.get("value")->visit([&](auto&& value) {
-      table->insert_or_assign(std::string(parts.back()), std::move(value));
-    });
+    parsed.get("value")->visit(
+        [&](auto& value) { table->insert_or_assign(std::string(parts.back()), std::move(value)); });
   }
 }
 

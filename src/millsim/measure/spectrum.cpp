@@ -24,7 +24,8 @@ std::string_view contact_type_name(ContactType type) {
 
 ImpactSpectrum::ImpactSpectrum(double lowest_energy, int bins_per_decade, int decades)
     : lowest_energy_(lowest_energy), bins_per_decade_(bins_per_decade) {
-  const auto bins = static_cast<std::size_t>(bins_per_decade * decades);
+  const std::size_t bins =
+      static_cast<std::size_t>(bins_per_decade) * static_cast<std::size_t>(decades);
   for (auto& c : counts_) c.assign(bins, 0);
   for (auto& e : energies_) e.assign(bins, 0.0);
 }
