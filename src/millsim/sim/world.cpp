@@ -737,7 +737,15 @@ std::size_t World<D>::list_pairs_of(std::size_t begin, std::size_t end, std::siz
   for (std::size_t q = begin; q < end; ++q) {
     if (prefetch && q + position_ahead < pairs) __builtin_prefetch(&x[second[q + position_ahead]]);
     const std::uint32_t i = first[q];
-    const std::uint32_t j = second[q];
+    std::uint32_t j = second[q];
+    // Only the pairs whose second particle is below `below`: one at or beyond it belongs to
+    // another thread, which may be moving it now. Its position is not read (a data race,
+    // though the distance would be dropped): the pair's first particle stands in for it.
+    unsigned own = 1U;
+    if constexpr (!every_pair) {
+      own = j < below ? 1U : 0U;
+      j = own != 0U ? j : i;
+    }
     double distance_squared = 0.0;
     if constexpr (D == 2) {
       // Both components at once (never periodic in 2D): the same bits as norm_squared.
@@ -755,9 +763,9 @@ std::size_t World<D>::list_pairs_of(std::size_t begin, std::size_t end, std::siz
       distance_squared = (squares[0] + squares[1]) + dz * dz;
     }
     const double reach = r[i] + r[j];
-    unsigned keep = (distance_squared < reach * reach ? 1U : 0U) |
-                    (touching[q] == TouchState::touching ? 1U : 0U);
-    if constexpr (!every_pair) keep &= j < below ? 1U : 0U;
+    const unsigned keep = ((distance_squared < reach * reach ? 1U : 0U) |
+                           (touching[q] == TouchState::touching ? 1U : 0U)) &
+                          own;
     listed[count] = static_cast<std::uint32_t>(q);
     count += keep;
   }
