@@ -8,22 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-600}
 case "$seconds" in ''|*[!0-9]*|0) echo "usage: $0 [SECONDS]" >&2; exit 2 ;; esac
-bash scripts/install-deps.sh
-packages=(clang libclang-rt-14-dev libomp-14-dev)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  if [ "$(id -u)" -ne 0 ]; then
-    echo "millsim: fuzzing needs ${missing[*]}; run as root, or: sudo apt-get install ${missing[*]}" >&2
-    exit 1
-  fi
-  echo "millsim: installing ${missing[*]}" >&2
-  export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq
-  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
+bash scripts/install-deps.sh clang libclang-rt-14-dev libomp-14-dev
 cmake --preset fuzz >/dev/null
 cmake --build --preset fuzz
 mkdir -p build/fuzz/work build/fuzz/found build/fuzz/seeds

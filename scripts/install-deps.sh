@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Installs, with apt-get, whatever millsim needs to build and test that is not yet installed.
-# Debian 12 packages only. Sourced by run-example.sh and test.sh; safe to run again.
+# Installs, with apt-get, whatever millsim needs to build and test that is not yet installed,
+# and the Debian packages named as arguments (the checks' scripts: tidy.sh, tsan.sh, fuzz.sh).
+# Debian 12 packages only. Run by run-example.sh, test.sh and those; safe to run again.
+#   scripts/install-deps.sh [PACKAGE ...]
 set -euo pipefail
 
 packages=(g++ cmake ninja-build pkg-config libtomlplusplus-dev libcli11-dev libfmt-dev
-          libgtest-dev googletest)
+          libgtest-dev googletest "$@")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

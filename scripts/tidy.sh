@@ -4,17 +4,7 @@
 # (about 8 minutes on two cores).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
-if ! command -v run-clang-tidy >/dev/null; then
-  if [ "$(id -u)" -ne 0 ]; then
-    echo "millsim: clang-tidy is missing and installing it needs root: sudo apt-get install clang-tidy" >&2
-    exit 1
-  fi
-  echo "millsim: installing clang-tidy" >&2
-  export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq
-  apt-get install -y -qq --no-install-recommends clang-tidy >/dev/null
-fi
+bash scripts/install-deps.sh clang-tidy
 cmake --preset release >/dev/null
 # The compile commands, and the header the build generates (src/millsim/core/version.cpp
 # includes it).

@@ -5,22 +5,7 @@
 # it after clang-tidy (a few minutes on two cores).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
-packages=(clang libclang-rt-14-dev libomp-14-dev)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  if [ "$(id -u)" -ne 0 ]; then
-    echo "millsim: the TSan build needs ${missing[*]}; run as root, or: sudo apt-get install ${missing[*]}" >&2
-    exit 1
-  fi
-  echo "millsim: installing ${missing[*]}" >&2
-  export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq
-  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
+bash scripts/install-deps.sh clang libclang-rt-14-dev libomp-14-dev
 cmake --preset tsan >/dev/null
 cmake --build --preset tsan
 ctest --preset tsan
