@@ -1519,7 +1519,8 @@ bool World<D>::run_stages_split_among_threads() {
     }
 #pragma omp barrier
     const std::size_t mixed = mixed_blocks_.size();
-#pragma omp for schedule(static)
+    // nowait: the end of the parallel region is the barrier after this loop.
+#pragma omp for schedule(static) nowait
     for (std::size_t k = 0; k < mixed; ++k) {
       const std::size_t b = mixed_blocks_[k];
       double dissipated = 0.0;
