@@ -19,10 +19,11 @@ void expect_shares(const std::vector<double>& actual, const std::vector<double>&
   EXPECT_NEAR(total, 1.0, 1e-12);
 }
 
-TEST(RunShares, ASlowerRunGetsLessHalfTheWay) {
+TEST(RunShares, ASlowerRunGetsLessAQuarterOfTheWay) {
   // Equal weights, the second run three times slower: speeds 100 and 33.3, measured shares
-  // 0.75 and 0.25; half the way from 0.5 each: 0.625 and 0.375.
-  expect_shares(balanced_run_shares({0.5, 0.5}, {100.0, 100.0}, {1.0, 3.0}), {0.625, 0.375});
+  // 0.75 and 0.25; a quarter of the way (run_share_gain) from 0.5 each: 0.5625 and 0.4375.
+  ASSERT_EQ(run_share_gain, 0.25);
+  expect_shares(balanced_run_shares({0.5, 0.5}, {100.0, 100.0}, {1.0, 3.0}), {0.5625, 0.4375});
 }
 
 TEST(RunShares, BalancedRunsKeepTheirShares) {
@@ -32,19 +33,18 @@ TEST(RunShares, BalancedRunsKeepTheirShares) {
 }
 
 TEST(RunShares, ThreeRuns) {
-  // Speeds 10, 20 and 10 (weights 10, 40, 30 in 1, 2, 3 s): measured 0.25, 0.5, 0.25; half the
-  // way from even thirds: 0.291667, 0.416667, 0.291667 (within [1/6, 2/3]).
+  // Speeds 10, 20 and 10 (weights 10, 40, 30 in 1, 2, 3 s): measured 0.25, 0.5, 0.25; a
+  // quarter of the way from even thirds: 0.3125, 0.375, 0.3125 (within [1/6, 2/3]).
   const double third = 1.0 / 3.0;
   expect_shares(balanced_run_shares({third, third, third}, {10.0, 40.0, 30.0}, {1.0, 2.0, 3.0}),
-                {0.5 * (third + 0.25), 0.5 * (third + 0.5), 0.5 * (third + 0.25)});
+                {0.3125, 0.375, 0.3125});
 }
 
 TEST(RunShares, KeptWithinAFactorOfTwoOfEven) {
-  // Measured 0.01 and 0.99 (speeds 1 and 99) from 0.26 and 0.74: half the way 0.135 and 0.865;
-  // the first raised to a half of even, 0.25, then both scaled by 1 / 1.115: 0.224215 and
-  // 0.775785.
+  // Measured 0.01 and 0.99 (speeds 1 and 99) from 0.26 and 0.74: a quarter of the way 0.1975
+  // and 0.8025; the first raised to a half of even, 0.25, then both scaled by 1 / 1.0525.
   expect_shares(balanced_run_shares({0.26, 0.74}, {1.0, 99.0}, {1.0, 1.0}),
-                {0.25 / 1.115, 0.865 / 1.115});
+                {0.25 / 1.0525, 0.8025 / 1.0525});
 }
 
 TEST(RunShares, UntimedOnlyBroughtWithinBounds) {

@@ -81,7 +81,9 @@ std::vector<double> balanced_run_shares(const std::vector<double>& shares,
   for (std::size_t r = 0; r < runs; ++r) {
     // Untimed (a run left empty, say), the shares are only brought within bounds, so that
     // every run holds some weight and is timed next time.
-    const double aim = timed ? 0.5 * (shares[r] + weights[r] / seconds[r] / speeds) : shares[r];
+    const double aim =
+        timed ? shares[r] + run_share_gain * (weights[r] / seconds[r] / speeds - shares[r])
+              : shares[r];
     balanced[r] = std::clamp(aim, 0.5 * even, 2.0 * even);
     total += balanced[r];
   }
