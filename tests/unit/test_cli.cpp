@@ -3,10 +3,13 @@
 // test runs the built program in a fresh temporary directory.
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -336,6 +339,28 @@ TEST_F(Cli, RefusesAMissingConfigFile) {
   EXPECT_TRUE(o.err.starts_with("millsim: error: no-such-mill.toml: no such config file")) << o.err;
   EXPECT_NE(o.err.find("allowed: the path of a mill config file"), std::string::npos) << o.err;
   EXPECT_TRUE(fs::is_empty(work_));
+}
+
+TEST_F(Cli, RefusesAConfigThatIsNotARegularFileOrIsFarTooLarge) {
+  // A FIFO with no writer would block the read for ever, /dev/zero would fill the memory.
+  ASSERT_EQ(::mkfifo((work_ / "pipe.toml").c_str(), 0600), 0) << std::strerror(errno);
+  const Outcome pipe = millsim("info pipe.toml");
+  EXPECT_EQ(pipe.status, 2) << pipe.err;
+  EXPECT_NE(pipe.err.find("pipe.toml: is not a regular file (a device, pipe or socket)"),
+            std::string::npos)
+      << pipe.err;
+  const Outcome zero = millsim("run /dev/zero -o out -q");
+  EXPECT_EQ(zero.status, 2) << zero.err;
+  EXPECT_NE(zero.err.find("/dev/zero: is not a regular file"), std::string::npos) << zero.err;
+  // A sparse file of 65 MiB: a size no config has.
+  std::ofstream(work_ / "huge.toml").close();
+  fs::resize_file(work_ / "huge.toml", 65u << 20);
+  const Outcome huge = millsim("info huge.toml");
+  EXPECT_EQ(huge.status, 2) << huge.err;
+  EXPECT_NE(huge.err.find("huge.toml: is 68157440 bytes long; allowed:"), std::string::npos)
+      << huge.err;
+  EXPECT_NE(huge.err.find("at most 64 MiB"), std::string::npos) << huge.err;
+  EXPECT_FALSE(fs::exists(work_ / "out"));
 }
 
 TEST_F(Cli, RefusesAnEmptyConfigPathOrOutputDirectory) {

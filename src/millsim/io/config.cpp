@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -673,6 +674,10 @@ SceneConfig read_scene_config(const toml::table& document, const std::string& so
   return config;
 }
 
+/// A config is a few kilobytes; a scene listing its particles one by one, some megabytes. A file
+/// far larger is not a config (and toml++ would hold all of it, and more, in memory).
+constexpr std::uintmax_t max_config_bytes = std::uintmax_t{64} << 20;
+
 std::string read_config_file(const std::string& path) {
   const std::string allowed =
       "the path of a mill config file (TOML), e.g. examples/lab-mill-2d.toml";
@@ -684,6 +689,17 @@ std::string read_config_file(const std::string& path) {
   if (std::filesystem::is_directory(status)) {
     throw InputError(
         fmt::format("{}: is a directory, not a config file; allowed: {}", path, allowed));
+  }
+  // A pipe or device would be read until it ends, which it may never do (a FIFO with no writer
+  // blocks; /dev/zero fills the memory).
+  if (!std::filesystem::is_regular_file(status)) {
+    throw InputError(fmt::format(
+        "{}: is not a regular file (a device, pipe or socket); allowed: {}", path, allowed));
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (!error && size > max_config_bytes) {
+    throw InputError(fmt::format("{}: is {} bytes long; allowed: {}, at most {} MiB", path, size,
+                                 allowed, max_config_bytes >> 20));
   }
   std::ifstream file(path, std::ios::binary);
   if (!file) {
