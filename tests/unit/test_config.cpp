@@ -435,6 +435,34 @@ TEST(Config, AnOverrideGivesOneValueOnceAndNeverAWholeTable) {
   EXPECT_EQ(sized.sizes.size(), 1u);
 }
 
+TEST(Config, AnOverrideOfOneOfTwoAlternativeKeysReplacesTheFilesOther) {
+  // The file gives mill.speed and charge.ball_diameter; a sweep over speed_rpm or top_size
+  // must be able to replace them.
+  const MillConfig rpm = parse_mill_config(base_config, file_name, {"mill.speed_rpm=20"});
+  EXPECT_FALSE(rpm.speed_fraction.has_value());
+  EXPECT_DOUBLE_EQ(rpm.speed_rpm.value_or(0.0), 20.0);
+  const MillConfig back =
+      parse_mill_config(with(base_config, "speed", "speed_rpm = 20"), file_name, {"mill.speed=0.6"});
+  EXPECT_DOUBLE_EQ(back.speed_fraction.value_or(0.0), 0.6);
+  EXPECT_FALSE(back.speed_rpm.has_value());
+  const MillConfig graded = parse_mill_config(base_config, file_name, {"charge.top_size=0.05"});
+  EXPECT_EQ(graded.sizes.size(), 4u);
+  EXPECT_DOUBLE_EQ(graded.sizes[0].diameter, 0.05);
+  const MillConfig listed = parse_mill_config(
+      base_config, file_name, {"charge.sizes=[{diameter = 0.04, mass_fraction = 1.0}]"});
+  ASSERT_EQ(listed.sizes.size(), 1u);
+  EXPECT_DOUBLE_EQ(listed.sizes[0].diameter, 0.04);
+  // Two overrides of alternatives still contradict each other.
+  expect_has(error_of(base_config, {"mill.speed_rpm=20", "mill.speed=0.6"}),
+             {"command line (--set mill.speed_rpm=20)", "given as well as mill.speed",
+              "(command line (--set mill.speed=0.6))", "not both"});
+  expect_has(error_of(base_config, {"charge.top_size=0.05", "charge.ball_diameter=0.04"}),
+             {"given as well as charge.ball_diameter", "not several"});
+  // Two alternatives in the file are refused as before, whatever else is set.
+  const std::string both = with(base_config, "speed", "speed = 0.5\nspeed_rpm = 20");
+  expect_has(error_of(both, {"mill.length=0.2"}), {at_line(both, "speed_rpm"), "not both"});
+}
+
 TEST(Config, RefusesANulInTheOutputPath) {
   // TOML allows \u0000 in a string; a path would be cut at it.
   expect_has(error_of(with(base_config, "directory", "directory = \"out\\u0000x\"")),

@@ -405,7 +405,11 @@ toml::table parse_document(std::string_view toml_text, const std::string& source
         "(https://toml.io), as in examples/lab-mill-2d.toml",
         source, error.source().begin.line, error.source().begin.column, error.description()));
   }
-  apply_overrides(document, overrides);
+  // The keys of which a mill config gives one: a --set of one replaces the file's other.
+  static const std::vector<std::vector<std::string_view>> alternatives = {
+      {"mill.speed", "mill.speed_rpm"},
+      {"charge.ball_diameter", "charge.top_size", "charge.sizes"}};
+  apply_overrides(document, overrides, alternatives);
   return document;
 }
 

@@ -388,7 +388,29 @@ TableReader TableReader::table(std::string_view key, bool required, std::string_
                      true);
 }
 
-void apply_overrides(toml::table& document, const std::vector<std::string>& overrides) {
+namespace {
+
+/// Removes the dotted `key` from `document` if it is there.
+void erase_key(toml::table& document, std::string_view key) {
+  toml::table* table = &document;
+  for (std::size_t start = 0;;) {
+    const auto dot = key.find('.', start);
+    const std::string part(key.substr(start, dot == std::string_view::npos ? dot : dot - start));
+    if (dot == std::string_view::npos) {
+      table->erase(part);
+      return;
+    }
+    toml::node* next = table->get(part);
+    if (next == nullptr || !next->is_table()) return;
+    table = next->as_table();
+    start = dot + 1;
+  }
+}
+
+}  // namespace
+
+void apply_overrides(toml::table& document, const std::vector<std::string>& overrides,
+                     const std::vector<std::vector<std::string_view>>& alternatives) {
   std::vector<std::pair<std::string, std::string>> given;  // key, option: each key once
   for (const std::string& text : overrides) {
     const std::string option = fmt::format("{}{}", override_prefix, printable(text));
@@ -456,6 +478,15 @@ void apply_overrides(toml::table& document, const std::vector<std::string>& over
     }
     parsed.get("value")->visit(
         [&](auto& value) { table->insert_or_assign(std::string(parts.back()), std::move(value)); });
+  }
+  const auto overridden = [&](std::string_view key) {
+    return std::any_of(given.begin(), given.end(), [&](const auto& g) { return g.first == key; });
+  };
+  for (const std::vector<std::string_view>& group : alternatives) {
+    if (std::none_of(group.begin(), group.end(), overridden)) continue;
+    for (const std::string_view key : group) {
+      if (!overridden(key)) erase_key(document, key);
+    }
   }
 }
 

@@ -110,6 +110,12 @@ class TableReader {
 /// (0.75, "text", [1, 2]); anything that is not valid TOML is taken as a plain string. Every
 /// node an override creates carries the option as its source, so that a message about it names
 /// the option. Throws InputError for an override that is not KEY=VALUE.
-void apply_overrides(toml::table& document, const std::vector<std::string>& overrides);
+///
+/// `alternatives` are groups of dotted keys of which a config gives one (mill.speed or
+/// mill.speed_rpm): an override of one removes the others where the file gives them, so that
+/// `--set mill.speed_rpm=20` works on a config that gives mill.speed. Those given by another
+/// override stay, for the reader to refuse as given twice.
+void apply_overrides(toml::table& document, const std::vector<std::string>& overrides,
+                     const std::vector<std::vector<std::string_view>>& alternatives = {});
 
 }  // namespace millsim
