@@ -437,7 +437,11 @@ int validate_command(const std::string& directory, const JobOptions& options) {
                r.measured, paper, r.predicted, 100.0 * error, paper_error, ok ? "yes" : "NO",
                100.0 * r.tolerance);
   }
-  return failures == 0 ? 0 : 1;
+  if (failures > 0) {
+    fmt::print(stderr, "millsim: {} of {} cases outside their tolerance\n", failures, rows.size());
+    return 1;
+  }
+  return 0;
 }
 
 /// Reads every point's config and plans it before running any, so that a bad key or value
