@@ -13,11 +13,13 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <initializer_list>
 #include <new>
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <variant>
 #include <vector>
@@ -188,10 +190,21 @@ std::string output_location(const Config& config, const JobOptions& options) {
   return config.location_of("output.directory");
 }
 
-/// Plans, places the charge, and only then creates the output directory and runs, so that a
-/// config that cannot run writes nothing.
+/// Prints each warning on stderr as "millsim: warning: [CONTEXT: ]TEXT" (sweep points print
+/// from several threads).
+void warn(const std::vector<std::string>& warnings, std::string_view context = {}) {
+  for (const std::string& text : warnings) {
+#pragma omp critical(millsim_warning)
+    fmt::print(stderr, "millsim: warning: {}{}{}\n", context, context.empty() ? "" : ": ", text);
+  }
+}
+
+/// Plans, places the charge, and only then creates the output directory, calls `started`,
+/// gives the plan's warnings and runs, so that a config that cannot run writes nothing and
+/// says nothing but why. The results' own warnings follow the run.
 template <int D>
-MillResult run_job(const MillPlan& plan, const std::string& out_location, bool show_progress) {
+MillResult run_job(const MillPlan& plan, const std::string& out_location, bool show_progress,
+                   const std::function<void()>& started = {}) {
   const MillConfig& config = plan.config;
   millsim::World<D> world = millsim::build_mill_world<D>(plan);
   const std::filesystem::path out = config.output_directory;
@@ -199,18 +212,22 @@ MillResult run_job(const MillPlan& plan, const std::string& out_location, bool s
                            {"summary.json", "power.csv", "power_timeseries.csv", "spectrum.csv",
                             "charge_profile.csv", "impacts.csv"},
                            config.snapshot_interval > 0.0 ? Snapshots::made : Snapshots::removed);
+  if (started) started();
+  warn(plan.warnings);
   const std::filesystem::path snapshots = out / "snapshots";
   ProgressLine progress(show_progress);
   MillResult result = millsim::run_mill(plan, std::move(world), snapshots, std::ref(progress));
   progress.clear();
   millsim::write_results(out, result);
+  warn(millsim::result_warnings(result), fmt::format("results in {}/", config.output_directory));
   return result;
 }
 
-MillResult run_job(const MillConfig& config, const std::string& out_location, bool show_progress) {
+MillResult run_job(const MillConfig& config, const std::string& out_location, bool show_progress,
+                   const std::function<void()>& started) {
   const MillPlan plan = millsim::plan_mill(config);
-  return config.dimension == 2 ? run_job<2>(plan, out_location, show_progress)
-                               : run_job<3>(plan, out_location, show_progress);
+  return config.dimension == 2 ? run_job<2>(plan, out_location, show_progress, started)
+                               : run_job<3>(plan, out_location, show_progress, started);
 }
 
 /// Runs a scene (particles and walls, no mill): plans first so that a config that cannot run
@@ -239,8 +256,10 @@ int run_command(const JobOptions& options) {
     return run_scene_command(*scene, options);
   }
   const MillConfig& config = std::get<MillConfig>(job);
-  if (!options.quiet) fmt::print("millsim: running {}\n", config.source);
-  const MillResult result = run_job(config, output_location(config, options), !options.quiet);
+  const MillResult result =
+      run_job(config, output_location(config, options), !options.quiet, [&] {
+        if (!options.quiet) fmt::print("millsim: running {}\n", config.source);
+      });
   fmt::print("{}\n", millsim::summary_line(result));
   if (!options.quiet) {
     fmt::print(
@@ -289,6 +308,7 @@ int info_command(const JobOptions& options) {
   const bool place = static_cast<double>(plan.particle_count) <= most_placed_by_info;
   if (place && c.dimension == 2) (void)millsim::build_mill_world<2>(plan);
   if (place && c.dimension == 3) (void)millsim::build_mill_world<3>(plan);
+  warn(plan.warnings);
   fmt::print("config                {}\n", c.source);
   fmt::print("mill                  {} m x {} m, {} lifters {} x {} m (height x width)\n",
              c.diameter, c.length, c.lifter_count, c.lifter_height, c.lifter_width);
@@ -414,10 +434,12 @@ int validate_command(const std::string& directory, const JobOptions& options) {
   std::vector<Row> rows;
   for (const MillPlan& plan : plans) {
     const MillConfig& config = plan.config;
-    if (!options.quiet) fmt::print(stderr, "running {} ...\n", config.source);
+    const auto started = [&] {
+      if (!options.quiet) fmt::print(stderr, "running {} ...\n", config.source);
+    };
     const MillResult result = config.dimension == 2
-                                  ? run_job<2>(plan, root_location, !options.quiet)
-                                  : run_job<3>(plan, root_location, !options.quiet);
+                                  ? run_job<2>(plan, root_location, !options.quiet, started)
+                                  : run_job<3>(plan, root_location, !options.quiet, started);
     rows.push_back({config.reference->case_name, config.reference->measured_kw, result.power_kw,
                     config.reference->tolerance, config.reference->paper_kw});
   }
@@ -460,7 +482,14 @@ std::vector<MillPlan> plan_sweep(const JobOptions& options,
       MillConfig config = load(point);
       config.output_directory =
           (root / millsim::point_directory_name(i, points.size(), axes, points[i])).string();
-      plans.push_back(millsim::plan_mill(config));
+      MillPlan plan = millsim::plan_mill(config);
+      // The charge placed as the run places it (as validate does), so that a filling the mill
+      // cannot hold refuses the sweep before any point runs.
+      if (static_cast<double>(plan.particle_count) <= most_placed_by_info) {
+        if (plan.config.dimension == 2) (void)millsim::build_mill_world<2>(plan);
+        if (plan.config.dimension == 3) (void)millsim::build_mill_world<3>(plan);
+      }
+      plans.push_back(std::move(plan));
     } catch (const millsim::InputError& error) {
       throw millsim::InputError(
           fmt::format("sweep point {} ({}): {}", i, fmt::join(settings, ", "), error.what()));
@@ -517,6 +546,20 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
   axes.reserve(vary_arguments.size());
   for (const std::string& argument : vary_arguments) axes.push_back(millsim::parse_vary(argument));
   millsim::check_sweep_axes(axes);
+  // Caught here, where both options can be named, rather than by each point's config.
+  for (const millsim::SweepAxis& axis : axes) {
+    for (const std::string& setting : options.overrides) {
+      const std::string_view text = setting;
+      std::string_view key = text.substr(0, text.find('='));
+      while (!key.empty() && key.back() == ' ') key.remove_suffix(1);
+      while (!key.empty() && key.front() == ' ') key.remove_prefix(1);
+      if (key != axis.key) continue;
+      throw millsim::InputError(fmt::format(
+          "command line (--vary {}=...): {} is also given as --set {}; allowed: a key either "
+          "varied or set",
+          axis.key, axis.key, setting));
+    }
+  }
   refuse_output_directory_set(options, "sweep");
   const std::vector<std::vector<std::string>> points = millsim::cartesian_product(axes);
   const std::filesystem::path root =

@@ -149,6 +149,44 @@ TEST(EmpiricalPower, SummaryJsonLeavesOutBondsPowerWhereItDoesNotApply) {
   EXPECT_NE(summary_line(result).find("empirical: Bond n/a"), std::string::npos);
 }
 
+TEST(EmpiricalPower, ResultWarningsFlagAnOpenEnergyBalanceOrPowersThatDisagree) {
+  MillResult result;
+  result.plan = plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", {}));
+  result.power_kw = 1.0;
+  result.power_dissipation_kw = 1.09;  // 8.3 % of the larger apart: within 10 %
+  result.energy_balance_error = 0.049;
+  EXPECT_TRUE(result_warnings(result).empty());
+  result.power_dissipation_kw = 1.12;  // 10.7 % apart
+  ASSERT_EQ(result_warnings(result).size(), 1u);
+  EXPECT_NE(result_warnings(result)[0].find(
+                "power by torque (1 kW) and by dissipation (1.12 kW) differ by more than 10 %"),
+            std::string::npos)
+      << result_warnings(result)[0];
+  result.power_dissipation_kw = 0.89;  // the other way round: 11 % of the larger
+  EXPECT_EQ(result_warnings(result).size(), 1u);
+  // An open balance explains the powers' disagreement: it alone is reported.
+  result.energy_balance_error = 0.051;
+  ASSERT_EQ(result_warnings(result).size(), 1u);
+  EXPECT_NE(result_warnings(result)[0].find("the energy balance is off by 0.051"),
+            std::string::npos)
+      << result_warnings(result)[0];
+  result.energy_balance_error = std::nan("");
+  EXPECT_EQ(result_warnings(result).size(), 1u);
+}
+
+TEST(EmpiricalPower, TheSummaryLineShowsTheSpreadOnlyWhenSeveralRevolutionsAreMeasured) {
+  MillResult result;
+  result.plan = plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", {}));
+  result.power_std_kw = 0.0123;
+  EXPECT_NE(summary_line(result).find("±0.012 kW between revolutions"), std::string::npos)
+      << summary_line(result);
+  result.plan = plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml",
+                                            {"simulation.measure_revolutions=1"}));
+  EXPECT_NE(summary_line(result).find("one revolution measured"), std::string::npos)
+      << summary_line(result);
+  EXPECT_EQ(summary_line(result).find("between revolutions"), std::string::npos);
+}
+
 TEST(EmpiricalPower, SummaryJsonRefusesAFigureThatIsNotFinite) {
   // JSON has no infinity or NaN: a diverged run is reported as failed, not written as "inf".
   MillResult result;

@@ -193,6 +193,22 @@ TEST(MillPlan, GivenTimeStepIsUsedBelowTheStabilityLimitAndRefusedAboveIt) {
   EXPECT_THROW(plan_mill(lab_mill({"simulation.time_step=1.1e-3"})), InputError);
 }
 
+TEST(MillPlan, AGivenTimeStepOfFewerThanTenStepsPerContactIsRunWithAWarning) {
+  // The shortest contact is t_c = 2.6038361e-3 s (above): 10 steps are 2.6038361e-4 s.
+  EXPECT_TRUE(plan_mill(lab_mill()).warnings.empty());  // auto: 20 steps
+  EXPECT_TRUE(plan_mill(lab_mill({"simulation.time_step=2.6e-4"})).warnings.empty());
+  const MillPlan coarse = plan_mill(lab_mill({"simulation.time_step=5.2e-4"}));
+  EXPECT_EQ(coarse.time_step, 5.2e-4);
+  ASSERT_EQ(coarse.warnings.size(), 1u);
+  const std::string& warning = coarse.warnings[0];
+  for (const std::string_view part :
+       {"command line (--set simulation.time_step=5.2e-4): simulation.time_step: 0.00052 s",
+        "shortest contact (0.0026 s) in 5.01 steps, fewer than 10",
+        "\"auto\" takes 0.00013 s, 1/20 of it"}) {
+    EXPECT_NE(warning.find(part), std::string::npos) << warning;
+  }
+}
+
 TEST(MillPlan, AutoTimeStepStaysAtAQuarterOfTheStabilityLimitWhenTheTangentialSpringIsStiff) {
   // k_s = 1e9 N/m: the tangential ω = sqrt(6 k_s/m) = sqrt(6e9/0.53540739) = 1.0586038e5 s⁻¹,
   // limit 2/ω = 1.8892810e-5 s, far below t_c/20 = 1.3019180e-4 s: the step is a quarter of it,

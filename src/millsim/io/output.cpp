@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <sstream>
@@ -293,11 +294,15 @@ std::string summary_json(const MillResult& r) {
 
 std::string summary_line(const MillResult& r) {
   const EmpiricalPower empirical = empirical_power(r.plan);
+  // One measured revolution has no spread to show.
+  const std::string spread = r.plan.config.measure_revolutions > 1
+                                 ? fmt::format("±{:.2g} kW between revolutions", r.power_std_kw)
+                                 : std::string("one revolution measured");
   return fmt::format(
-      "power {:.4g} kW (dissipation {:.4g} kW, ±{:.2g} kW between revolutions) at {:.3g} rpm "
+      "power {:.4g} kW (dissipation {:.4g} kW, {}) at {:.3g} rpm "
       "({:.0f}% of critical); empirical: {}, Hogg-Fuerstenau {:.4g} kW, Morrell "
       "net {:.4g} kW; {} {}, {} steps in {:.1f} s ({:.3g} particle-steps/s)",
-      r.power_kw, r.power_dissipation_kw, r.power_std_kw, r.plan.speed_rpm,
+      r.power_kw, r.power_dissipation_kw, spread, r.plan.speed_rpm,
       100.0 * r.plan.speed_fraction, bond_power_text(empirical.bond),
       empirical.hogg_fuerstenau.power_kw, empirical.morrell.net_kw, r.plan.particle_count,
       r.plan.config.dimension == 2 ? "discs" : "balls", r.steps, r.wall_seconds,
@@ -312,6 +317,27 @@ void write_results(const std::filesystem::path& directory, const MillResult& res
   write_whole_file(directory / "charge_profile.csv", charge_profile_table(result));
   write_whole_file(directory / "impacts.csv", impacts_table(result));
   write_whole_file(directory / "summary.json", summary);
+}
+
+std::vector<std::string> result_warnings(const MillResult& r) {
+  std::vector<std::string> warnings;
+  if (!(r.energy_balance_error <= doubtful_energy_balance_error)) {
+    warnings.push_back(fmt::format(
+        "the energy balance is off by {:.3g} of the shell's work (more than {:.0f} %): the time "
+        "step may be too coarse for these contacts, and the results are doubtful",
+        r.energy_balance_error, 100.0 * doubtful_energy_balance_error));
+  }
+  // A balance that does not close explains any disagreement of the two powers.
+  const double larger = std::max(std::abs(r.power_kw), std::abs(r.power_dissipation_kw));
+  if (warnings.empty() && larger > 0.0 &&
+      std::abs(r.power_kw - r.power_dissipation_kw) > doubtful_power_disagreement * larger) {
+    warnings.push_back(fmt::format(
+        "power by torque ({:.4g} kW) and by dissipation ({:.4g} kW) differ by more than {:.0f} %: "
+        "the charge was not steady over the measured revolutions (the first revolution includes "
+        "the spin-up; run more revolutions than are measured)",
+        r.power_kw, r.power_dissipation_kw, 100.0 * doubtful_power_disagreement));
+  }
+  return warnings;
 }
 
 }  // namespace millsim

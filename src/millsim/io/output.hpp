@@ -35,4 +35,14 @@ std::vector<std::pair<std::string, double>> summary_scalars(const MillResult& re
 /// (measure/empirical_power.hpp) beside it.
 std::string summary_line(const MillResult& result);
 
+/// A run whose energy balance error exceeds this is reported as doubtful (result_warnings).
+inline constexpr double doubtful_energy_balance_error = 0.05;
+/// Power by torque and by dissipation further apart than this, relative to the larger, is
+/// reported as doubtful: the measured window was not steady.
+inline constexpr double doubtful_power_disagreement = 0.10;
+
+/// What in the results says they are doubtful, one sentence each (none for a sound run): an
+/// energy balance that does not close, power by torque and by dissipation that disagree.
+std::vector<std::string> result_warnings(const MillResult& result);
+
 }  // namespace millsim

@@ -203,6 +203,16 @@ MillPlan plan_mill(const MillConfig& config) {
           accurate, steps_per_contact, plan.critical_time_step));
     }
     plan.time_step = *config.time_step;
+    const double shortest =
+        std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall);
+    if (plan.time_step * fewest_steps_per_contact > shortest) {
+      plan.warnings.push_back(fmt::format(
+          "{}: simulation.time_step: {:.4g} s resolves the shortest contact ({:.3g} s) in {:.3g} "
+          "steps, fewer than {:.0f}: the results may be inaccurate (\"auto\" takes {:.3g} s, "
+          "1/{:.0f} of it)",
+          config.location_of("simulation.time_step"), plan.time_step, shortest,
+          shortest / plan.time_step, fewest_steps_per_contact, accurate, steps_per_contact));
+    }
   } else {
     // 1/20 of the shortest contact, and never above a quarter of the stability limit: with a
     // tangential stiffness far above the normal one the tangential oscillation is the faster.

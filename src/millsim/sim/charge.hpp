@@ -2,6 +2,7 @@
 // and the charge placed in the mill.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "millsim/io/config.hpp"
@@ -14,6 +15,9 @@ namespace millsim {
 inline constexpr double disc_bed_porosity = 0.2;
 /// Default steps per contact duration of the stiffest, lightest pair ("auto" time step).
 inline constexpr double steps_per_contact = 20.0;
+/// A time step given in the config with fewer steps than this per shortest contact is stable
+/// but coarse (MODEL.md §4: "at least ~10–20"): the run is made, with a warning.
+inline constexpr double fewest_steps_per_contact = 10.0;
 
 /// One size of the simulated charge: discs in 2D, spheres in 3D.
 struct DiscClass {
@@ -57,6 +61,9 @@ struct MillPlan {
   /// s, settling + rotation: settle_time + spin_up_time / 2 + revolutions × revolution_period
   /// (the ramp turns the shell as half its time at full speed would)
   double total_time = 0.0;
+  /// What in the config makes the results doubtful without making the run impossible (a
+  /// coarse time step), one sentence each, naming the file, line and key.
+  std::vector<std::string> warnings;
 };
 
 /// Area of the part of a circle of `radius` below the horizontal line at `level` from its
