@@ -256,10 +256,9 @@ int run_command(const JobOptions& options) {
     return run_scene_command(*scene, options);
   }
   const MillConfig& config = std::get<MillConfig>(job);
-  const MillResult result =
-      run_job(config, output_location(config, options), !options.quiet, [&] {
-        if (!options.quiet) fmt::print("millsim: running {}\n", config.source);
-      });
+  const MillResult result = run_job(config, output_location(config, options), !options.quiet, [&] {
+    if (!options.quiet) fmt::print("millsim: running {}\n", config.source);
+  });
   fmt::print("{}\n", millsim::summary_line(result));
   if (!options.quiet) {
     fmt::print(
@@ -274,8 +273,9 @@ int scene_info(const millsim::SceneConfig& scene) {
   const millsim::ScenePlan plan = millsim::plan_scene(scene);
   fmt::print("config                {}\n", scene.source);
   fmt::print(
-      "scene                 {}D, {} particles, {} plane walls, gravity {}\n", scene.dimension,
-      scene.particles.size(), scene.walls.size(),
+      "scene                 {}D, {} {}, {} plane {}, gravity {}\n", scene.dimension,
+      scene.particles.size(), scene.particles.size() == 1 ? "particle" : "particles",
+      scene.walls.size(), scene.walls.size() == 1 ? "wall" : "walls",
       fmt::join(std::span(scene.gravity).first(static_cast<std::size_t>(scene.dimension)), ", "));
   if (plan.shortest_contact > 0.0) {
     fmt::print("shortest contact      {:.4g} s\n", plan.shortest_contact);
@@ -310,8 +310,12 @@ int info_command(const JobOptions& options) {
   if (place && c.dimension == 3) (void)millsim::build_mill_world<3>(plan);
   warn(plan.warnings);
   fmt::print("config                {}\n", c.source);
-  fmt::print("mill                  {} m x {} m, {} lifters {} x {} m (height x width)\n",
-             c.diameter, c.length, c.lifter_count, c.lifter_height, c.lifter_width);
+  const std::string lifters = c.lifter_count == 0
+                                  ? std::string("no lifters")
+                                  : fmt::format("{} {} {} x {} m (height x width)", c.lifter_count,
+                                                c.lifter_count == 1 ? "lifter" : "lifters",
+                                                c.lifter_height, c.lifter_width);
+  fmt::print("mill                  {} m x {} m, {}\n", c.diameter, c.length, lifters);
   fmt::print("critical speed        {:.4g} rpm (largest ball {} m)\n", plan.critical_speed_rpm,
              plan.largest_ball);
   fmt::print("speed                 {:.4g} rpm = {:.1f}% of critical, {:.4g} s per revolution\n",
@@ -351,9 +355,10 @@ int info_command(const JobOptions& options) {
              c.time_step ? "" : " (auto)", plan.critical_time_step);
   const double steps = plan.total_time / plan.time_step;
   fmt::print(
-      "simulated time        {:.4g} s: settle {} s, then {} revolutions from a spin-up of "
-      "{:.4g} s; {:.3g} steps\n",
-      plan.total_time, c.settle_time, c.revolutions, plan.spin_up_time, steps);
+      "simulated time        {:.4g} s: settle {} s, then {} {} from a spin-up of {:.4g} s; "
+      "{:.3g} steps\n",
+      plan.total_time, c.settle_time, c.revolutions,
+      c.revolutions == 1 ? "revolution" : "revolutions", plan.spin_up_time, steps);
   const millsim::EmpiricalPower empirical = millsim::empirical_power(plan);
   fmt::print("empirical power       {}, Hogg-Fuerstenau {:.4g} kW, Morrell net {:.4g} kW\n",
              millsim::bond_power_text(empirical.bond), empirical.hogg_fuerstenau.power_kw,
@@ -600,7 +605,8 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
   return 0;
 }
 
-void add_job_options(CLI::App& command, JobOptions& options) {
+/// --set, -j and -q; `quiet` says what -q leaves of the command's output.
+void add_job_options(CLI::App& command, JobOptions& options, const std::string& quiet) {
   command.add_option("--set", options.overrides,
                      "override a config key, e.g. --set mill.speed=0.75 (repeatable)");
   command
@@ -621,7 +627,7 @@ void add_job_options(CLI::App& command, JobOptions& options) {
             return {};
           },
           "1 to 1024"));
-  command.add_flag("-q,--quiet", options.quiet, "print only the one-line summary");
+  command.add_flag("-q,--quiet", options.quiet, quiet);
 }
 
 /// The program: parses the command line and runs the command. Errors it foresees are reported
@@ -634,16 +640,20 @@ int run_program(int argc, char** argv) {
   JobOptions options;
   std::string validation_directory = "examples/validation";
 
-  CLI::App* run = app.add_subcommand("run", "simulate a mill and report its power draft");
+  CLI::App* run = app.add_subcommand(
+      "run", "simulate a mill and report its power draft, or a scene of particles and walls");
   run->add_option("config", options.config_path,
-                  "mill config (TOML); default: the built-in example");
+                  "mill or scene config (TOML); default: the built-in example mill");
   run->add_option("-o,--out", options.output_directory,
                   "output directory (overrides output.directory)");
-  add_job_options(*run, options);
+  add_job_options(*run, options,
+                  "print only the one-line summary (no progress line, no \"running\" and "
+                  "\"results in\" lines)");
 
-  CLI::App* info = app.add_subcommand("info", "print derived quantities of a mill, no simulation");
+  CLI::App* info =
+      app.add_subcommand("info", "print derived quantities of a mill or a scene, no simulation");
   info->add_option("config", options.config_path,
-                   "mill config (TOML); default: the built-in example");
+                   "mill or scene config (TOML); default: the built-in example mill");
   info->add_option("--set", options.overrides, "override a config key (repeatable)");
 
   CLI::App* validate = app.add_subcommand(
@@ -652,7 +662,7 @@ int run_program(int argc, char** argv) {
       ->capture_default_str();
   validate->add_option("-o,--out", options.output_directory,
                        "where the runs go (default runs/validation)");
-  add_job_options(*validate, options);
+  add_job_options(*validate, options, "print only the table (no line per case, no progress lines)");
 
   std::vector<std::string> vary_arguments;
   CLI::App* sweep = app.add_subcommand(
@@ -666,7 +676,8 @@ int run_program(int argc, char** argv) {
       ->allow_extra_args(false);
   sweep->add_option("-o,--out", options.output_directory,
                     "where the points and sweep.csv go (default runs/sweep)");
-  add_job_options(*sweep, options);
+  add_job_options(*sweep, options,
+                  "print only the table (no line per point, no progress or other lines)");
 
   try {
     app.parse(argc, argv);
