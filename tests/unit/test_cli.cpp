@@ -283,8 +283,7 @@ TEST_F(Cli, RefusesAFillingTheMillCannotHoldBothInRunAndInInfo) {
                                             "charge.filling=0.3,0.9 ") +
                                 tiny_run);
   EXPECT_EQ(sweep.status, 2) << sweep.err;
-  EXPECT_NE(sweep.err.find("sweep point 1 (charge.filling=0.9)"), std::string::npos)
-      << sweep.err;
+  EXPECT_NE(sweep.err.find("sweep point 1 (charge.filling=0.9)"), std::string::npos) << sweep.err;
   EXPECT_NE(sweep.err.find("could not place"), std::string::npos) << sweep.err;
   EXPECT_FALSE(fs::exists(work_ / "runs"));
 
@@ -379,8 +378,9 @@ TEST_F(Cli, RefusesAConfigThatIsNotARegularFileOrIsFarTooLarge) {
 
 TEST_F(Cli, ASweepRefusesAKeyBothVariedAndSet) {
   write_config(base_config);
-  const Outcome o = millsim("sweep mill.toml -q -o runs --vary mill.speed=0.3,0.4 --set "
-                            "mill.speed=0.5");
+  const Outcome o = millsim(
+      "sweep mill.toml -q -o runs --vary mill.speed=0.3,0.4 --set "
+      "mill.speed=0.5");
   EXPECT_EQ(o.status, 2) << o.err;
   EXPECT_EQ(o.err,
             "millsim: error: command line (--vary mill.speed=...): mill.speed is also given as "
@@ -392,8 +392,8 @@ TEST_F(Cli, ACoarseTimeStepAndADoubtfulResultAreRunWithWarnings) {
   // The base config's shortest contact is 2.6 ms: 0.9 ms is stable but under 3 steps a contact,
   // and the energy balance of such a run does not close.
   write_config(base_config);
-  const Outcome o = millsim(std::string("run mill.toml -q -o out --set simulation.time_step=9e-4 ") +
-                            tiny_run);
+  const Outcome o =
+      millsim(std::string("run mill.toml -q -o out --set simulation.time_step=9e-4 ") + tiny_run);
   EXPECT_EQ(o.status, 0) << o.err;
   EXPECT_NE(o.err.find("millsim: warning: command line (--set simulation.time_step=9e-4): "
                        "simulation.time_step: 0.0009 s resolves the shortest contact"),
@@ -585,9 +585,9 @@ TEST_F(Cli, ValidateReadsEveryCaseBeforeRunningAnyAndShowsAMissingPaperFigureAsN
   }
   EXPECT_EQ(good.status, outside == 0 ? 0 : 1) << good.err;
   // Before it, only warnings (a run of one revolution measures the spin-up, which they say).
-  const std::string count_line =
-      outside == 0 ? std::string()
-                   : "millsim: " + std::to_string(outside) + " of 2 cases outside their tolerance\n";
+  const std::string count_line = outside == 0 ? std::string()
+                                              : "millsim: " + std::to_string(outside) +
+                                                    " of 2 cases outside their tolerance\n";
   EXPECT_TRUE(good.err.ends_with(count_line)) << good.err;
   std::istringstream err_lines(good.err.substr(0, good.err.size() - count_line.size()));
   for (std::string line; std::getline(err_lines, line);) {

@@ -441,8 +441,8 @@ TEST(Config, AnOverrideOfOneOfTwoAlternativeKeysReplacesTheFilesOther) {
   const MillConfig rpm = parse_mill_config(base_config, file_name, {"mill.speed_rpm=20"});
   EXPECT_FALSE(rpm.speed_fraction.has_value());
   EXPECT_DOUBLE_EQ(rpm.speed_rpm.value_or(0.0), 20.0);
-  const MillConfig back =
-      parse_mill_config(with(base_config, "speed", "speed_rpm = 20"), file_name, {"mill.speed=0.6"});
+  const MillConfig back = parse_mill_config(with(base_config, "speed", "speed_rpm = 20"), file_name,
+                                            {"mill.speed=0.6"});
   EXPECT_DOUBLE_EQ(back.speed_fraction.value_or(0.0), 0.6);
   EXPECT_FALSE(back.speed_rpm.has_value());
   const MillConfig graded = parse_mill_config(base_config, file_name, {"charge.top_size=0.05"});

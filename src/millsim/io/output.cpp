@@ -302,11 +302,10 @@ std::string summary_line(const MillResult& r) {
       "power {:.4g} kW (dissipation {:.4g} kW, {}) at {:.3g} rpm "
       "({:.0f}% of critical); empirical: {}, Hogg-Fuerstenau {:.4g} kW, Morrell "
       "net {:.4g} kW; {} {}, {} steps in {:.1f} s ({:.3g} particle-steps/s)",
-      r.power_kw, r.power_dissipation_kw, spread, r.plan.speed_rpm,
-      100.0 * r.plan.speed_fraction, bond_power_text(empirical.bond),
-      empirical.hogg_fuerstenau.power_kw, empirical.morrell.net_kw, r.plan.particle_count,
-      r.plan.config.dimension == 2 ? "discs" : "balls", r.steps, r.wall_seconds,
-      r.particle_steps_per_second);
+      r.power_kw, r.power_dissipation_kw, spread, r.plan.speed_rpm, 100.0 * r.plan.speed_fraction,
+      bond_power_text(empirical.bond), empirical.hogg_fuerstenau.power_kw, empirical.morrell.net_kw,
+      r.plan.particle_count, r.plan.config.dimension == 2 ? "discs" : "balls", r.steps,
+      r.wall_seconds, r.particle_steps_per_second);
 }
 
 void write_results(const std::filesystem::path& directory, const MillResult& result) {
