@@ -130,9 +130,13 @@ TEST_F(SweepPowerCurve, ResultsDoNotDependOnTheThreadsAndEveryPointHasItsDirecto
 }
 
 TEST_F(SweepPowerCurve, AFailedPointIsReportedAndTheOthersStillRun) {
-  // A filling of 0.95 passes the config checks but its discs do not fit when placed.
+  // Every point's config and charge are checked before any runs (a filling of 0.95, whose discs
+  // do not fit, refuses the whole sweep: tests/unit/test_cli.cpp). What can still fail is the
+  // run itself: here point 1's output directory, taken by a file.
+  fs::create_directories(work_ / "f");
+  std::ofstream(work_ / "f" / "001_charge.filling=0.25") << "a file, not a directory\n";
   const Outcome o =
-      millsim("sweep " + quoted(small_mill) + " --vary charge.filling=0.2,0.95,0.3 -q --out f" +
+      millsim("sweep " + quoted(small_mill) + " --vary charge.filling=0.2,0.25,0.3 -q --out f" +
               tiny_run + tiny_speed);
   EXPECT_EQ(o.status, 1) << o.err;
   EXPECT_NE(o.err.find("1 of 3 points failed"), std::string::npos) << o.err;
