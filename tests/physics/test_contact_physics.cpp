@@ -414,6 +414,63 @@ TEST(SlidingDisc, StartsRollingAtTwoThirdsOfItsSpeed) {
               0.1 * resting_overlap);
 }
 
+// The 2D counterpart of the elastic oblique impacts of the verification scenes (their 3D
+// sticking and sliding closed forms): a disc hits the floor at speed v and angle θ from the
+// normal, e = 1 and no spin. The contact point's tangential motion is an oscillator of mass
+// m_t with 1/m_t = 1/m + r²/I = 3/m (I = m r²/2), so with k_s = k_n/3 its frequency
+// sqrt(3 k_s/m) is the normal one, sqrt(k_n/m), and F_t/F_n = (k_s/k_n) tan θ = tan θ/3 all
+// through the impact.
+// - tan θ ≤ 3 μ: the contact sticks throughout and leaves after half a period with the contact
+//   point's tangential velocity reversed. Tangential impulse J_t = 2 m_t v_t = (2/3) m v_t:
+//   v_t' = v_t/3, and ω' = −J_t r/I = −4 v_t/(3 r) (clockwise for a disc moving along +x).
+// - tan θ ≥ 3 μ (1 + e) = 6 μ: it slides throughout, J_t = μ (1 + e) m v_n = 2 μ m v_n:
+//   v_t' = v_t − 2 μ v_n, ω' = −4 μ v_n/r.
+// A wrong k_s (or a wrong disc inertia) moves the sticking answers far off.
+TEST(ObliqueImpact2D, ElasticDiscsStickOrSlideAsTheClosedFormSays) {
+  const double mass = 2.0;
+  const double mu = 0.1;
+  const ContactMaterial material{1.0e6, 1.0e6 / 3.0, 1.0, mu};
+  int sticking = 0;
+  int sliding = 0;
+  for (const double degrees : {5.0, 10.0, 15.0, 35.0, 45.0, 60.0, 75.0}) {
+    SCOPED_TRACE(fmt::format("{} degrees from the normal", degrees));
+    const double angle = degrees * pi / 180.0;
+    const double vn = approach_speed * std::cos(angle);
+    const double vt = approach_speed * std::sin(angle);
+    WorldSettings<2> settings;
+    settings.time_step = contact_duration(material, mass) / steps_per_contact;
+    settings.ball_wall = material;
+    Walls<2> walls;
+    walls.planes.push_back(Plane<2>{Vec2{{0.0, 0.0}}, Vec2{{0.0, 1.0}}});
+    World<2> world(settings, walls);
+    const double gap = free_flight_steps * settings.time_step * vn;
+    world.particles().add(Vec2{{0.0, disc_radius + gap}}, disc_radius, mass, Vec2{{vt, -vn}});
+    const MeasuredImpact measured = measure_impact(
+        world, disc_wall_overlap, [](const World<2>& w) { return w.particles().velocity[0][1]; });
+    const double normal_restitution = measured.restitution * approach_speed / vn;
+    const double tangential_restitution = world.particles().velocity[0][0] / vt;
+    const double spin = world.particles().angular_velocity[0];
+    EXPECT_NEAR(normal_restitution, 1.0, 1e-3);
+    const double t = std::tan(angle);
+    if (t <= 3.0 * mu) {
+      ++sticking;
+      EXPECT_NEAR(tangential_restitution, 1.0 / 3.0, 0.01 / 3.0);
+      const double expected_spin = -4.0 * vt / (3.0 * disc_radius);
+      EXPECT_NEAR(spin, expected_spin, 0.01 * std::abs(expected_spin));
+    } else {
+      ASSERT_GE(t, 6.0 * mu);
+      ++sliding;
+      const double expected = 1.0 - 2.0 * mu * vn / vt;
+      EXPECT_NEAR(tangential_restitution, expected, 0.01 * expected);
+      const double expected_spin = -4.0 * mu * vn / disc_radius;
+      EXPECT_NEAR(spin, expected_spin, 0.01 * std::abs(expected_spin));
+    }
+    EXPECT_NEAR(measured.energy_balance, 0.0, energy_balance_tolerance);
+  }
+  EXPECT_EQ(sticking, 3);
+  EXPECT_EQ(sliding, 4);
+}
+
 // Kinetic energy at the time of the positions, from the half-step velocities either side:
 // u̇(n) = (u̇(n−½) + u̇(n+½))/2, and the same for ω. stored_spring_energy() after a step is that
 // of the overlaps at u(n), so the two add up to the energy at one instant.

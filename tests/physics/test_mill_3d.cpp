@@ -601,8 +601,9 @@ TEST(Mill3D, EnergyAccountClosesAndBothPowersAgree) {
   // Case 3D-g, settled 0.6 s, turned three revolutions, measured over the last two, at the
   // default time step (what users run; the bound is 1 %), and at half of it. The account's
   // error is the integration's, not noise: at the default it closes to 0.60 % here (0.60 % and
-  // 0.61 % in the 3D validation runs), at half the step to 0.057 %, about a tenth; it must at
-  // least halve.
+  // 0.61 % in the 3D validation runs), at half the step to 0.057 %, about a tenth. The leapfrog's
+  // energy error is second order in the step, so halving it must take the error to a quarter or
+  // less: held to 0.35 of the default's.
   const MillPlan default_plan = plan_mill(lab_mill_config());
   const std::vector<std::string> run_settings = {
       "simulation.settle_time=0.6", "simulation.revolutions=3", "simulation.measure_revolutions=2"};
@@ -613,7 +614,7 @@ TEST(Mill3D, EnergyAccountClosesAndBothPowersAgree) {
   halved.push_back(fmt::format("simulation.time_step={}", 0.5 * default_plan.time_step));
   const MillResult at_half = run_3d(lab_mill_config(halved));
   testing::expect_energy_account_closes(at_half);
-  EXPECT_LT(at_half.energy_balance_error, 0.5 * at_default.energy_balance_error);
+  EXPECT_LT(at_half.energy_balance_error, 0.35 * at_default.energy_balance_error);
   ::testing::Test::RecordProperty("energy_balance_error_default_step",
                                   fmt::format("{:.3g}", at_default.energy_balance_error));
   ::testing::Test::RecordProperty("energy_balance_error_half_step",

@@ -4,7 +4,9 @@
 
 #include <cmath>
 
+#include "millsim/contact/linear_spring_dashpot.hpp"
 #include "millsim/core/constants.hpp"
+#include "millsim/core/lanes.hpp"
 #include "millsim/particles/material.hpp"
 
 namespace millsim {
@@ -49,6 +51,27 @@ TEST(Material, NormalAndTangentialDampingByHand) {
   // Against a wall m* is the particle's own mass: c_n scales as sqrt(m*).
   EXPECT_NEAR(normal_damping(steel(), 2.0 * pair_mass),
               std::sqrt(2.0) * normal_damping(steel(), pair_mass), 1e-12);
+}
+
+TEST(Material, TheContactLawDampsWithTheseCoefficients) {
+  // The law computes its dashpots itself, from ζ and the square roots of the stiffnesses kept
+  // at construction: the same c_n = 143.54934 and c_s = 124.31738 N s/m as above, on one
+  // contact and on four at once (each lane its own m*: 0.5, 1.0 = 2 × 0.5, 0.125 = 0.5 / 4).
+  const LinearSpringDashpot law(steel());
+  const ContactDampingOf<double> one = law.damping(pair_mass);
+  EXPECT_NEAR(one.normal, 143.54934, 143.54934 * hand_tolerance);
+  EXPECT_NEAR(one.tangential, 124.31738, 124.31738 * hand_tolerance);
+  const ContactDampingOf<Lanes> four =
+      law.damping(Lanes{pair_mass, 2.0 * pair_mass, 0.125, pair_mass});
+  const double scale[4] = {1.0, std::sqrt(2.0), 0.5, 1.0};
+  for (int lane = 0; lane < 4; ++lane) {
+    EXPECT_NEAR(four.normal[lane], scale[lane] * 143.54934, 143.54934 * hand_tolerance) << lane;
+    EXPECT_NEAR(four.tangential[lane], scale[lane] * 124.31738, 124.31738 * hand_tolerance) << lane;
+  }
+  // A perfectly elastic contact has no dashpot at all.
+  const ContactDampingOf<double> elastic = LinearSpringDashpot(steel(1.0)).damping(pair_mass);
+  EXPECT_EQ(elastic.normal, 0.0);
+  EXPECT_EQ(elastic.tangential, 0.0);
 }
 
 TEST(Material, ContactDurationByHand) {
