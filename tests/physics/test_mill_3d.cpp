@@ -459,11 +459,20 @@ TEST(Mill3DWall, FastImpactsOnEdgesAndCornersNeverLeak) {
     }
   }
   // Every shot lands (seen: 10 000 of 10 000; the bound leaves room for a few grazing past),
-  // the fastest close to 20 m/s, and no wall ever pressed into a ball deeper than a head-on
-  // 20 m/s impact does (seen: 0.01722 m; 0.017 m estimated above).
+  // the fastest close to 20 m/s, and no wall ever pressed into a ball much deeper than a
+  // head-on 20 m/s impact does. That impact's deepest overlap is the damped oscillator's first
+  // peak, (v/ω0) exp(−ζ φ/sqrt(1 − ζ²)) with φ = atan(sqrt(1 − ζ²)/ζ): for e = 0.5, ζ =
+  // 0.21545376, φ = 1.3536, the factor 0.7418, so 0.023139 × 0.7418 = 0.017164 m. Allowed 5 %
+  // more for the step (t_c/20 samples the peak) and for a ball pressed by two walls at once
+  // in a corner (seen: 0.01722 m).
   EXPECT_GT(hits, 0.95 * shots);
   EXPECT_GT(fastest, 19.5);
-  EXPECT_LT(deepest, 0.018);
+  const double zeta = damping_ratio(steel_ball_wall.restitution);
+  const double root = std::sqrt(1.0 - zeta * zeta);
+  const double head_on_peak = 20.0 * std::sqrt(ball_mass / steel_ball_wall.normal_stiffness) *
+                              std::exp(-zeta / root * std::atan(root / zeta));
+  EXPECT_NEAR(head_on_peak, 0.017164, 1e-5);
+  EXPECT_LT(deepest, 1.05 * head_on_peak);
 }
 
 // ---- Whole mills --------------------------------------------------------------------------
