@@ -1,6 +1,7 @@
 // The neighbour list (search/neighbour_list.hpp) against a brute-force search over all pairs:
 // the same pairs in the same order, a refresh exactly when some particle has moved more than
-// half the skin, and the history of kept pairs carried over a rebuild.
+// half the skin, and the history of kept pairs carried over a rebuild, also one that renumbers
+// the particles.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -349,6 +350,92 @@ TEST(NeighbourList, KeptPairsKeepTheirHistoryNewPairsStartClearDiscs) {
 
 TEST(NeighbourList, KeptPairsKeepTheirHistoryNewPairsStartClearSpheres) {
   check_history_carry_over<3>();
+}
+
+/// A pair's tangential spring as the force on its second particle, of normal n from the first
+/// to the second: the spring itself in 3D, in 2D its length times the tangent of n.
+template <int D>
+Vec<D> tangential_force_on_second(const ContactHistory<D>& h, const Vec<D>& n) {
+  if constexpr (D == 2) {
+    return h.tangential_spring * tangent_of(n);
+  } else {
+    return h.tangential_spring;
+  }
+}
+
+template <int D>
+void check_history_carried_into_cell_order() {
+  const Cloud<D> cloud = random_cloud<D>(cloud_size, box_side<D>, 23);
+  NeighbourList<D> list(skin);
+  list.rebuild(cloud.position, cloud.radius);
+  const auto normal = [&](std::uint32_t from, std::uint32_t to) {
+    const Vec<D> offset = list.separation(cloud.position[from], cloud.position[to]);
+    return offset * (1.0 / norm(offset));
+  };
+
+  // Every pair's history marked with values unique to it; the tangential spring, in 3D a
+  // vector along no axis, taken down as the force it makes on the pair's second particle.
+  struct Marked {
+    double marker;
+    Vec<D> force_on_second;
+  };
+  std::map<std::pair<std::uint32_t, std::uint32_t>, Marked> marked;
+  for (std::size_t p = 0; p < list.pair_count(); ++p) {
+    const std::uint32_t a = list.first()[p];
+    const std::uint32_t b = list.second()[p];
+    const double m = 1000.0 + static_cast<double>(p);
+    ContactHistory<D>& h = list.history()[p];
+    h.dissipated = m;
+    h.normal_spring_origin = -m;
+    if constexpr (D == 2) {
+      h.tangential_spring = 3.0 * m;
+    } else {
+      h.tangential_spring = Vec3{{3.0 * m, -2.0 * m, 0.5 * m}};
+    }
+    list.touching()[p] = TouchState::touching;
+    marked[{a, b}] = {m, tangential_force_on_second(h, normal(a, b))};
+  }
+
+  // Renumbered into cell order, nothing moved: the same pairs, in new numbers. A pair whose
+  // particles come in the other order now has its bodies A and B swapped, and the normal
+  // n' = −n. The force on each physical particle must not change, so the force on the new
+  // second (the old first) is minus the old force on the old second (Newton's third law). In
+  // 3D the spring is that force: it is negated. In 2D it is a length s along the tangent, and
+  // tangent_of(−n) = −t: s t' = −s t with s kept. (−n is exactly minus n, the offset being
+  // negated and its length the same, so the forces compare exactly.)
+  list.rebuild(cloud.position, cloud.radius, true);
+  const std::vector<std::uint32_t>& previous = list.previous_index();
+  std::size_t swapped = 0;
+  std::size_t kept_order = 0;
+  for (std::size_t p = 0; p < list.pair_count(); ++p) {
+    const std::uint32_t first = previous[list.first()[p]];
+    const std::uint32_t second = previous[list.second()[p]];
+    const bool is_swapped = first > second;
+    const auto found = marked.find({std::min(first, second), std::max(first, second)});
+    ASSERT_NE(found, marked.end()) << "pair " << first << "-" << second << " was not listed";
+    (is_swapped ? swapped : kept_order) += 1;
+    const ContactHistory<D>& h = list.history()[p];
+    const Vec<D> expected =
+        is_swapped ? -found->second.force_on_second : found->second.force_on_second;
+    SCOPED_TRACE(testing::Message() << "pair " << first << "-" << second);
+    EXPECT_EQ(tangential_force_on_second(h, normal(first, second)), expected);
+    EXPECT_EQ(h.dissipated, found->second.marker);
+    EXPECT_EQ(h.normal_spring_origin, -found->second.marker);
+    EXPECT_EQ(list.touching()[p], TouchState::touching);
+  }
+  EXPECT_EQ(swapped + kept_order, marked.size());
+  // The test means something only if both kinds occur: a random cloud's numbering is far
+  // from the cells' order.
+  EXPECT_GT(swapped, 0u);
+  EXPECT_GT(kept_order, 0u);
+}
+
+TEST(NeighbourList, RenumberingKeepsTheTangentialForceOnEachParticleDiscs) {
+  check_history_carried_into_cell_order<2>();
+}
+
+TEST(NeighbourList, RenumberingKeepsTheTangentialForceOnEachParticleSpheres) {
+  check_history_carried_into_cell_order<3>();
 }
 
 TEST(NeighbourList, EmptyListStaysEmpty) {
