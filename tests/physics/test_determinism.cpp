@@ -361,6 +361,10 @@ TEST(Determinism, SmallSlabSplitInSmallBlocksIsTheSameOnOneTwoAndThreeThreads) {
   const Outcome<3> one = step_on(scene, 600, 1);
   expect_identical(one, step_on(scene, 600, 2));
   expect_identical(one, step_on(scene, 600, 3));
+  // A middle run with a hundredth of the weight, fewer pairs than a block: until the next
+  // split the block at its start holds pairs of all three runs, and the last of the three to
+  // finish its part sums it.
+  expect_identical(one, step_on(scene, 600, 3, true, {0.495, 0.01, 0.495}));
   const World<3>& world = one.world;
   EXPECT_GT(listed_pairs(world), parallel_pair_threshold);
   EXPECT_LT(world.pair_block_size(), 1024u);

@@ -536,17 +536,49 @@ void World<D>::split_pairs_among(int threads) {
     }
   }
   cross_force_.resize(cross_pairs_.size());
+  // The cross pairs by the run of their second particle, whose thread evaluates them
+  // (do_cross_pairs): a counting sort that keeps them in pair order within each run.
+  const auto run_of = [&](std::uint32_t particle) {
+    return static_cast<std::size_t>(
+        std::upper_bound(split_particle_.begin(), split_particle_.end(), particle) -
+        split_particle_.begin() - 1);
+  };
+  cross_of_run_begin_.assign(ranges + 1, 0);
+  for (const std::uint32_t q : cross_pairs_) ++cross_of_run_begin_[run_of(second[q]) + 1];
+  for (std::size_t run = 0; run < ranges; ++run) {
+    cross_of_run_begin_[run + 1] += cross_of_run_begin_[run];
+  }
+  cross_of_run_.resize(cross_pairs_.size());
+  cross_of_run_cursor_.assign(cross_of_run_begin_.begin(), cross_of_run_begin_.end() - 1);
+  for (std::size_t c = 0; c < cross_pairs_.size(); ++c) {
+    cross_of_run_[cross_of_run_cursor_[run_of(second[cross_pairs_[c]])]++] =
+        static_cast<std::uint32_t>(c);
+  }
   // Blocks of pairs that one thread cannot go through alone: those split between two runs and
   // those holding a cross pair.
   block_mixed_.assign(block_count(pairs, pair_block_), 0);
+  split_blocks_.clear();
   for (std::size_t range = 1; range < ranges; ++range) {
     const std::size_t q = split_pair_[range];
-    if (q % pair_block_ != 0 && q < pairs) block_mixed_[q / pair_block_] = 1;
+    if (q % pair_block_ == 0 || q >= pairs) continue;
+    block_mixed_[q / pair_block_] = 1;
+    if (split_blocks_.empty() || split_blocks_.back() != q / pair_block_) {
+      split_blocks_.push_back(static_cast<std::uint32_t>(q / pair_block_));
+    }
   }
   for (const std::uint32_t q : cross_pairs_) block_mixed_[q / pair_block_] = 1;
-  mixed_blocks_.clear();
-  for (std::size_t b = 0; b < block_mixed_.size(); ++b) {
-    if (block_mixed_[b] != 0) mixed_blocks_.push_back(static_cast<std::uint32_t>(b));
+  // How many runs hold pairs of each split block: the last of them to finish its part sums
+  // the block (finish_mixed_part).
+  split_block_parts_.assign(split_blocks_.size(), 0);
+  for (std::size_t k = 0; k < split_blocks_.size(); ++k) {
+    const std::size_t block_begin = std::size_t{split_blocks_[k]} * pair_block_;
+    const std::size_t block_end = std::min(pairs, block_begin + pair_block_);
+    for (std::size_t range = 0; range < ranges; ++range) {
+      if (std::max<std::size_t>(block_begin, split_pair_[range]) <
+          std::min<std::size_t>(block_end, split_pair_[range + 1])) {
+        ++split_block_parts_[k];
+      }
+    }
   }
   split_threads_ = threads;
   split_rebuild_ = neighbours_.rebuild_count();
@@ -1399,26 +1431,85 @@ void World<D>::do_shared_wall_block(std::size_t k) {
 }
 
 template <int D>
+void World<D>::do_cross_pairs(std::size_t run) {
+  if (cross_of_run_begin_[run] == cross_of_run_begin_[run + 1]) return;
+  // As do_shared_wall_block: 2 s + 1 once step s has done them, 2 s while a thread does them.
+  std::atomic<std::uint64_t>& flag = cross_done_[run];
+  const std::uint64_t taken = 2 * shared_wall_stamp_;
+  const std::uint64_t done = taken + 1;
+  std::uint64_t seen = flag.load(std::memory_order_acquire);
+  if (seen < taken && flag.compare_exchange_strong(seen, taken, std::memory_order_acquire)) {
+    for (std::size_t k = cross_of_run_begin_[run]; k < cross_of_run_begin_[run + 1]; ++k) {
+      const std::uint32_t c = cross_of_run_[k];
+      const std::uint32_t q = cross_pairs_[c];
+      const PairOutcome outcome = evaluate_pair(q, cross_force_[c]);
+      pair_status_[q] = outcome.status;
+      pair_energy_[q] = outcome.energy;
+    }
+    flag.store(done, std::memory_order_release);
+    flag.notify_all();
+    return;
+  }
+  // Another thread has taken them: wait until they are done.
+  while (seen != done) {
+    flag.wait(seen, std::memory_order_acquire);
+    seen = flag.load(std::memory_order_acquire);
+  }
+}
+
+template <int D>
+void World<D>::finish_mixed_part(std::size_t b) {
+  const auto split = std::lower_bound(split_blocks_.begin(), split_blocks_.end(), b);
+  if (split != split_blocks_.end() && *split == b) {
+    const auto k = static_cast<std::size_t>(split - split_blocks_.begin());
+    // Each run's part done, then counted (release); the thread of the last part sees them all
+    // (acquire) and sums the block.
+    if (split_block_done_[k].fetch_add(1, std::memory_order_acq_rel) + 1 < split_block_parts_[k])
+      return;
+  }
+  // Every pair's outcome in pair order, as one thread going through the block sums them.
+  double dissipated = 0.0;
+  std::uint32_t ended = 0;
+  const std::size_t end = std::min(pair_status_.size(), (b + 1) * pair_block_);
+  for (std::size_t q = b * pair_block_; q < end; ++q) {
+    if (pair_status_[q] == PairStatus::touching) {
+      dissipated += pair_energy_[q];
+    } else if (pair_status_[q] == PairStatus::ended) {
+      pair_ended_[b * pair_block_ + ended++] = {.type = ContactType::ball_ball,
+                                                .energy = pair_energy_[q]};
+    }
+  }
+  pair_block_dissipated_[b] = dissipated;
+  pair_block_ended_[b] = ended;
+}
+
+template <int D>
 bool World<D>::run_stages_split_among_threads() {
   // Thread t owns a run of particles and the pairs whose first particle is one of them
   // (split_pairs_among), and goes through the three stages on them interleaved, as
   // run_stages_in_one_pass does on one thread; the sums of every particle are made in the same
-  // order. A pair whose second particle belongs to a later thread (a cross pair: 1.5 % of the 3D
-  // 20 k scene's on two threads) is evaluated first, before a barrier; then each thread zeroes
-  // its particles, adds the cross pairs' forces to their second particles (they come before any
-  // of its own pairs in pair order), and goes down its own pairs, adding each one's force to both
-  // particles, or, for a cross pair, the stored force to the first. A block of pairs that lies in
-  // one thread's run and holds no cross pair is gone through as on one thread
-  // (evaluate_pair_block); in the others (mixed_blocks_: at most a few per thread) each pair's
-  // dissipation and end are kept apart and summed afterwards, in the same order. (Keeping every
-  // pair's apart cost a third more instructions per pair: callgrind, the 2D SAG scene.) A wall
-  // block is done by the thread that owns its candidates' particles, whose arrays are in its
-  // core's cache and whose sums it alone writes (on the 2D SAG scene, handing wall blocks to
-  // whichever thread came free moved those arrays between the cores at every step and cost 8 %
-  // of the step: bench/results.md). A block whose candidates belong to two threads is done by
-  // the later one first thing (do_shared_wall_block), each candidate's sums kept until its own
-  // thread adds them; the earlier thread needs it only at the end of its run. (Done before the
-  // barrier instead, it held the other thread waiting: 2D SAG, two threads, 2 % slower.)
+  // order. A pair whose second particle belongs to a later run (a cross pair: 1.5 % of the 3D
+  // 20 k scene's on two threads) is evaluated by that run's thread first thing
+  // (do_cross_pairs); the thread then zeroes its particles, adds the cross pairs' forces to
+  // their second particles (they come before any of its own pairs in pair order), and goes
+  // down its own pairs, adding each one's force to both particles, or, for a cross pair, the
+  // stored force to the first, which waits for the later runs' cross pairs at its first block
+  // that holds one (near its run's end, long after they were done). A block of pairs that lies
+  // in one run and holds no cross pair is gone through as on one thread (evaluate_pair_block);
+  // in the others (mixed: at most a few per run) each pair's dissipation and end are kept apart
+  // and summed in the same order by the last run to finish its part (finish_mixed_part).
+  // (Keeping every pair's apart cost a third more instructions per pair: callgrind, the 2D SAG
+  // scene.) So the runs wait for each other only where a flag says they must, and the step has
+  // one barrier, at the region's end: with a barrier after the cross pairs and another before
+  // the mixed blocks' sums, the 3D slab of 996 balls ran 5–10 % slower on two threads
+  // (bench/results.md). A wall block is done by the thread that owns its candidates'
+  // particles, whose arrays are in its core's cache and whose sums it alone writes (on the 2D
+  // SAG scene, handing wall blocks to whichever thread came free moved those arrays between the
+  // cores at every step and cost 8 % of the step: bench/results.md). A block whose candidates
+  // belong to two threads is done by the later one first thing (do_shared_wall_block), each
+  // candidate's sums kept until its own thread adds them; the earlier thread needs it only at
+  // the end of its run. (Done before the barrier instead, it held the other thread waiting: 2D
+  // SAG, two threads, 2 % slower.)
   const auto& first = neighbours_.first();
   const auto& second = neighbours_.second();
   const auto& r = particles_.radius;
@@ -1441,26 +1532,25 @@ bool World<D>::run_stages_split_among_threads() {
   }
   shared_wall_sums_.resize(shared_wall_blocks_.size() * wall_block_);
   shared_wall_done_.reserve(shared_wall_blocks_.size());
+  cross_done_.reserve(ranges);
   ++shared_wall_stamp_;
+  split_block_done_.reserve(split_blocks_.size());
+  for (std::size_t k = 0; k < split_blocks_.size(); ++k) {
+    split_block_done_[k].store(0, std::memory_order_relaxed);  // before the threads start
+  }
   pair_status_.resize(pairs);
   pair_energy_.resize(pairs);
   const std::size_t crossing = cross_pairs_.size();
   bool moved = false;
 #pragma omp parallel num_threads(split_threads_) reduction(|| : moved)
   {
-#pragma omp for schedule(static)
-    for (std::size_t c = 0; c < crossing; ++c) {
-      const std::uint32_t q = cross_pairs_[c];
-      const PairOutcome outcome = evaluate_pair(q, cross_force_[c]);
-      pair_status_[q] = outcome.status;
-      pair_energy_[q] = outcome.energy;
-    }
-    // The implicit barrier of the loop above: every cross pair's force is known.
     const auto team = static_cast<std::size_t>(omp_get_num_threads());
     for (auto t = static_cast<std::size_t>(omp_get_thread_num()); t < ranges; t += team) {
       const double run_start = omp_get_wtime();
       const std::uint32_t own_begin = split_particle_[t];
       const std::uint32_t own_end = split_particle_[t + 1];
+      // The cross pairs into this run, whose forces its particles take before any other.
+      do_cross_pairs(t);
       // A wall block shared with earlier runs that holds this run's first candidates: done now,
       // as a rule before the earlier run's thread needs it at the end of its run (a block is
       // done by whichever thread comes to it first, so that no thread waits for itself).
@@ -1482,6 +1572,7 @@ bool World<D>::run_stages_split_among_threads() {
           std::lower_bound(cross_pairs_.begin(), cross_pairs_.end(), split_pair_[t]) -
           cross_pairs_.begin());
       const std::size_t own_pairs_end = split_pair_[t + 1];
+      bool crosses_known = false;
       std::size_t q = split_pair_[t];
       while (q < own_pairs_end) {
         const std::size_t b = q / pair_block_;
@@ -1496,6 +1587,13 @@ bool World<D>::run_stages_split_among_threads() {
           // cross pair's second lies beyond this run, so its cross pairs come after all its
           // other pairs, and no pair after them in the list holds it.
           const std::size_t end = std::min(own_pairs_end, (b + 1) * pair_block_);
+          if (!crosses_known && c < crossing && cross_pairs_[c] < end) {
+            // The first block holding a cross pair out of this run, whose contact the listing
+            // below reads: the later runs' threads evaluated theirs at their start (a run not
+            // yet begun has them evaluated here).
+            for (std::size_t later = t + 1; later < ranges; ++later) do_cross_pairs(later);
+            crosses_known = true;
+          }
           for (std::size_t p = q; p < end; ++p) {
             if (second[p] < own_end) pair_status_[p] = PairStatus::apart;
           }
@@ -1512,6 +1610,7 @@ bool World<D>::run_stages_split_among_threads() {
               torque[i] += r[i] * cross_force_[c].moment;
             }
           }
+          finish_mixed_part(b);
           q = end;
         }
         run.advance_below(q < own_pairs_end ? std::size_t{first[q]} : std::size_t{own_end});
@@ -1519,26 +1618,6 @@ bool World<D>::run_stages_split_among_threads() {
       run.advance_below(own_end);
       moved = run.moved || moved;
       run_seconds_[t] += omp_get_wtime() - run_start;
-    }
-#pragma omp barrier
-    const std::size_t mixed = mixed_blocks_.size();
-    // nowait: the end of the parallel region is the barrier after this loop.
-#pragma omp for schedule(static) nowait
-    for (std::size_t k = 0; k < mixed; ++k) {
-      const std::size_t b = mixed_blocks_[k];
-      double dissipated = 0.0;
-      std::uint32_t ended = 0;
-      const std::size_t end = std::min(pairs, (b + 1) * pair_block_);
-      for (std::size_t q = b * pair_block_; q < end; ++q) {
-        if (pair_status_[q] == PairStatus::touching) {
-          dissipated += pair_energy_[q];
-        } else if (pair_status_[q] == PairStatus::ended) {
-          pair_ended_[b * pair_block_ + ended++] = {.type = ContactType::ball_ball,
-                                                    .energy = pair_energy_[q]};
-        }
-      }
-      pair_block_dissipated_[b] = dissipated;
-      pair_block_ended_[b] = ended;
     }
   }
   finish_pair_stage();

@@ -248,6 +248,13 @@ class World {
   /// Shared wall block k (shared_wall_blocks_[k]) done in this step, its candidates' sums kept
   /// (shared_wall_sums_): by this thread if no other has taken it, else waited for.
   void do_shared_wall_block(std::size_t k);
+  /// The cross pairs into run `run` (their second particle in it) evaluated in this step, their
+  /// forces in cross_force_ and outcomes in pair_status_ and pair_energy_: by this thread if no
+  /// other has taken them, else waited for.
+  void do_cross_pairs(std::size_t run);
+  /// A run's part of mixed block b done: the block's dissipation and ended collisions summed
+  /// from its pairs' outcomes, by the thread of the last run to finish its part of it.
+  void finish_mixed_part(std::size_t b);
   /// Where wall block `block` is in shared_wall_blocks_ (it must be there).
   std::size_t shared_wall_block_index(std::size_t block) const;
   /// Zeroes the force and torque sums of particles [begin, end).
@@ -483,7 +490,10 @@ class World {
   // Per block of pairs, whether it is split between two threads' runs or holds a cross pair
   // (then its pairs' status and energy are kept apart), and those blocks in order.
   std::vector<std::uint8_t> block_mixed_;
-  std::vector<std::uint32_t> mixed_blocks_;
+  // The blocks split between runs, in order; how many runs hold pairs of each; and how many of
+  // those have done their part in this step (finish_mixed_part).
+  std::vector<std::uint32_t> split_blocks_, split_block_parts_;
+  StepFlags split_block_done_;
   // Per thread (run_stages_split_among_threads), the first of its wall candidates; the wall
   // blocks that hold candidates of two threads, and their candidates' sums (wall_block_ each).
   std::vector<std::uint32_t> split_candidate_;
@@ -493,6 +503,11 @@ class World {
   // steps that have split the stages among threads, this one included.
   StepFlags shared_wall_done_;
   std::uint64_t shared_wall_stamp_ = 0;
+  // The cross pairs by the run of their second particle (indices into cross_pairs_, run u's
+  // from cross_of_run_begin_[u]), and per run how far the steps have evaluated them
+  // (do_cross_pairs, numbered as shared_wall_done_).
+  std::vector<std::uint32_t> cross_of_run_, cross_of_run_begin_, cross_of_run_cursor_;
+  StepFlags cross_done_;
   // Work is split in blocks of a fixed size; each block keeps its own sums and ended
   // collisions, added up in block order, so results do not depend on the number of threads.
   std::size_t pair_block_ = 1024;  // pairs per block, and candidates per wall block, chosen
