@@ -52,7 +52,8 @@ constexpr std::size_t parallel_candidate_threshold_when_split = 256;
 /// The pair stage, and with it the particle stages, split among threads from this many listed
 /// pairs, where two threads and one break even: below it the threads' barriers cost more than
 /// the split saves (the 3D scaling slab of 996 balls and 2 500 pairs on two threads against
-/// one: 1.1 times faster; bench/results.md).
+/// one: 1.1 times faster on an Intel host, 0.85 times on an AMD one, which broke even at about
+/// 5 000 pairs; bench/results.md).
 constexpr std::size_t parallel_pair_threshold = 2048;
 /// The same for the old three-stage path's wall stage, whose candidates cost tens of pairs
 /// each: from 512 on (the 2D SAG scene has about a thousand candidates; on one thread they held
