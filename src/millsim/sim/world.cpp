@@ -1411,15 +1411,18 @@ std::size_t World<D>::shared_wall_block_index(std::size_t block) const {
       shared_wall_blocks_.begin());
 }
 
-template <int D>
-void World<D>::do_shared_wall_block(std::size_t k) {
-  // The flag holds 2 s + 1 once step s has done the block, 2 s while a thread does it.
-  std::atomic<std::uint64_t>& flag = shared_wall_done_[k];
-  const std::uint64_t taken = 2 * shared_wall_stamp_;
+namespace {
+
+/// Work shared by the threads of one step (World's shared wall blocks and cross pairs), done
+/// once by whichever thread comes to it first while the others wait for it. The flag holds
+/// 2 s + 1 once step s has done it, 2 s while a thread does it; earlier steps left less.
+template <class Work>
+void do_once_in_step(std::atomic<std::uint64_t>& flag, std::uint64_t step, Work&& work) {
+  const std::uint64_t taken = 2 * step;
   const std::uint64_t done = taken + 1;
   std::uint64_t seen = flag.load(std::memory_order_acquire);
   if (seen < taken && flag.compare_exchange_strong(seen, taken, std::memory_order_acquire)) {
-    evaluate_wall_block(shared_wall_blocks_[k], &shared_wall_sums_[k * wall_block_]);
+    work();
     flag.store(done, std::memory_order_release);
     flag.notify_all();
     return;
@@ -1431,15 +1434,19 @@ void World<D>::do_shared_wall_block(std::size_t k) {
   }
 }
 
+}  // namespace
+
+template <int D>
+void World<D>::do_shared_wall_block(std::size_t k) {
+  do_once_in_step(shared_wall_done_[k], split_step_count_, [&] {
+    evaluate_wall_block(shared_wall_blocks_[k], &shared_wall_sums_[k * wall_block_]);
+  });
+}
+
 template <int D>
 void World<D>::do_cross_pairs(std::size_t run) {
   if (cross_of_run_begin_[run] == cross_of_run_begin_[run + 1]) return;
-  // As do_shared_wall_block: 2 s + 1 once step s has done them, 2 s while a thread does them.
-  std::atomic<std::uint64_t>& flag = cross_done_[run];
-  const std::uint64_t taken = 2 * shared_wall_stamp_;
-  const std::uint64_t done = taken + 1;
-  std::uint64_t seen = flag.load(std::memory_order_acquire);
-  if (seen < taken && flag.compare_exchange_strong(seen, taken, std::memory_order_acquire)) {
+  do_once_in_step(cross_done_[run], split_step_count_, [&] {
     for (std::size_t k = cross_of_run_begin_[run]; k < cross_of_run_begin_[run + 1]; ++k) {
       const std::uint32_t c = cross_of_run_[k];
       const std::uint32_t q = cross_pairs_[c];
@@ -1447,15 +1454,7 @@ void World<D>::do_cross_pairs(std::size_t run) {
       pair_status_[q] = outcome.status;
       pair_energy_[q] = outcome.energy;
     }
-    flag.store(done, std::memory_order_release);
-    flag.notify_all();
-    return;
-  }
-  // Another thread has taken them: wait until they are done.
-  while (seen != done) {
-    flag.wait(seen, std::memory_order_acquire);
-    seen = flag.load(std::memory_order_acquire);
-  }
+  });
 }
 
 template <int D>
@@ -1534,7 +1533,7 @@ bool World<D>::run_stages_split_among_threads() {
   shared_wall_sums_.resize(shared_wall_blocks_.size() * wall_block_);
   shared_wall_done_.reserve(shared_wall_blocks_.size());
   cross_done_.reserve(ranges);
-  ++shared_wall_stamp_;
+  ++split_step_count_;
   split_block_done_.reserve(split_blocks_.size());
   for (std::size_t k = 0; k < split_blocks_.size(); ++k) {
     split_block_done_[k].store(0, std::memory_order_relaxed);  // before the threads start

@@ -81,9 +81,11 @@ std::vector<double> balanced_run_shares(const std::vector<double>& shares,
                                         const std::vector<double>& weights,
                                         const std::vector<double>& seconds);
 
-/// Flags that threads set and wait on within a step (World's shared wall blocks), each holding
-/// a number that grows from step to step. Nothing is in flight between steps, so a copy starts
-/// with none, and they are made again (zero, below any step's number) when needed.
+/// Flags that threads set and wait on within a step: World's shared wall blocks and cross
+/// pairs, each holding a number that grows from step to step, and the counters of its blocks
+/// split between runs, zeroed before each step's threads start. Nothing is in flight between
+/// steps, so a copy starts with none, and they are made again (zero, below any step's number)
+/// when needed.
 class StepFlags {
  public:
   StepFlags() = default;
@@ -502,7 +504,7 @@ class World {
   // Per shared wall block, how far the steps have done it (do_shared_wall_block); the number of
   // steps that have split the stages among threads, this one included.
   StepFlags shared_wall_done_;
-  std::uint64_t shared_wall_stamp_ = 0;
+  std::uint64_t split_step_count_ = 0;
   // The cross pairs by the run of their second particle (indices into cross_pairs_, run u's
   // from cross_of_run_begin_[u]), and per run how far the steps have evaluated them
   // (do_cross_pairs, numbered as shared_wall_done_).
