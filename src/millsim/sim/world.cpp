@@ -550,10 +550,9 @@ void World<D>::split_pairs_among(int threads) {
     cross_of_run_begin_[run + 1] += cross_of_run_begin_[run];
   }
   cross_of_run_.resize(cross_pairs_.size());
-  cross_of_run_cursor_.assign(cross_of_run_begin_.begin(), cross_of_run_begin_.end() - 1);
+  std::vector<std::uint32_t> cursor(cross_of_run_begin_.begin(), cross_of_run_begin_.end() - 1);
   for (std::size_t c = 0; c < cross_pairs_.size(); ++c) {
-    cross_of_run_[cross_of_run_cursor_[run_of(second[cross_pairs_[c]])]++] =
-        static_cast<std::uint32_t>(c);
+    cross_of_run_[cursor[run_of(second[cross_pairs_[c]])]++] = static_cast<std::uint32_t>(c);
   }
   // Blocks of pairs that one thread cannot go through alone: those split between two runs and
   // those holding a cross pair.

@@ -508,7 +508,7 @@ class World {
   // The cross pairs by the run of their second particle (indices into cross_pairs_, run u's
   // from cross_of_run_begin_[u]), and per run how far the steps have evaluated them
   // (do_cross_pairs, numbered as shared_wall_done_).
-  std::vector<std::uint32_t> cross_of_run_, cross_of_run_begin_, cross_of_run_cursor_;
+  std::vector<std::uint32_t> cross_of_run_, cross_of_run_begin_;
   StepFlags cross_done_;
   // Work is split in blocks of a fixed size; each block keeps its own sums and ended
   // collisions, added up in block order, so results do not depend on the number of threads.
