@@ -3,6 +3,7 @@
 // half the skin, and the history of kept pairs carried over a rebuild, also one that renumbers
 // the particles.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -86,13 +87,18 @@ constexpr double box_side = D == 2 ? 40.0 : 14.0;
 template <int D>
 void check_matches_brute_force(std::uint64_t seed) {
   const Cloud<D> cloud = random_cloud<D>(cloud_size, box_side<D>, seed);
-  NeighbourList<D> list(skin);
-  list.rebuild(cloud.position, cloud.radius);
-  const PairList expected = brute_force_pairs(cloud, skin);
-  ASSERT_GT(expected.size(), cloud_size) << "the cloud should have more pairs than particles";
-  EXPECT_EQ(listed_pairs(list), expected);
-  EXPECT_EQ(list.history().size(), expected.size());
-  EXPECT_EQ(list.rebuild_count(), 1);
+  // The search one partner at a time, and four at a time where the processor has AVX2.
+  for (const bool lanes : {false, true}) {
+    SCOPED_TRACE(lanes ? "four partners at a time" : "one partner at a time");
+    NeighbourList<D> list(skin);
+    list.set_lane_search(lanes);
+    list.rebuild(cloud.position, cloud.radius);
+    const PairList expected = brute_force_pairs(cloud, skin);
+    ASSERT_GT(expected.size(), cloud_size) << "the cloud should have more pairs than particles";
+    EXPECT_EQ(listed_pairs(list), expected);
+    EXPECT_EQ(list.history().size(), expected.size());
+    EXPECT_EQ(list.rebuild_count(), 1);
+  }
 }
 
 TEST(NeighbourList, DiscPairsEqualBruteForceSortedByFirstThenSecond) {
@@ -126,12 +132,14 @@ PairList brute_force_pairs_periodic(const Cloud<D>& cloud, double list_skin, dou
 /// periodic (pairs across the ends found once).
 template <int D>
 void check_equal_radii(const std::vector<double>& sizes, double period) {
-  for (std::uint64_t seed : {4u, 5u}) {
+  for (const auto& [seed, lanes] : {std::pair{4u, false}, {4u, true}, {5u, false}, {5u, true}}) {
+    SCOPED_TRACE(lanes ? "four partners at a time" : "one partner at a time");
     Cloud<D> cloud = random_cloud<D>(cloud_size, box_side<D>, seed);
     std::mt19937_64 random(seed);
     std::uniform_int_distribution<std::size_t> pick(0, sizes.size() - 1);
     for (double& r : cloud.radius) r = sizes[pick(random)];
     NeighbourList<D> list(skin);
+    list.set_lane_search(lanes);
     list.set_period(period);
     list.rebuild(cloud.position, cloud.radius);
     const PairList expected = brute_force_pairs_periodic(cloud, skin, period);
@@ -436,6 +444,89 @@ TEST(NeighbourList, RenumberingKeepsTheTangentialForceOnEachParticleDiscs) {
 
 TEST(NeighbourList, RenumberingKeepsTheTangentialForceOnEachParticleSpheres) {
   check_history_carried_into_cell_order<3>();
+}
+
+/// Builds, marks every pair's history, moves the particles and builds again (into cell order
+/// if asked), on `threads` threads whose shares of the particles begin at `shares` (none:
+/// even shares), searching four partners at a time or not; gives the list.
+template <int D>
+NeighbourList<D> list_built_twice(const Cloud<D>& start, const Cloud<D>& moved, int threads,
+                                  const std::vector<std::uint32_t>& shares, bool into_cell_order,
+                                  bool lanes = true) {
+  const int threads_before = omp_get_max_threads();
+  omp_set_num_threads(threads);
+  NeighbourList<D> list(skin);
+  list.set_parallel(true);
+  list.set_lane_search(lanes);
+  list.set_thread_shares(shares);
+  list.rebuild(start.position, start.radius);
+  for (std::size_t p = 0; p < list.pair_count(); ++p) {
+    const double m = 1000.0 + static_cast<double>(list.first()[p]) +
+                     1e-4 * static_cast<double>(list.second()[p]);
+    ContactHistory<D>& h = list.history()[p];
+    h.dissipated = m;
+    h.normal_spring_origin = -m;
+    if constexpr (D == 2) {
+      h.tangential_spring = 3.0 * m;
+    } else {
+      h.tangential_spring = Vec3{{3.0 * m, -2.0 * m, 0.5 * m}};
+    }
+    list.touching()[p] = p % 3 == 0 ? TouchState::touching : TouchState::apart;
+  }
+  list.rebuild(moved.position, moved.radius, into_cell_order);
+  omp_set_num_threads(threads_before);
+  return list;
+}
+
+template <int D>
+void check_same_list_for_any_threads_and_shares() {
+  // Enough particles for the rebuild to run on several threads (at least 512 when asked).
+  constexpr std::size_t count = 3000;
+  const double side = D == 2 ? 40.0 * std::sqrt(10.0) : 14.0 * std::cbrt(10.0);
+  const Cloud<D> start = random_cloud<D>(count, side, 31);
+  Cloud<D> moved = start;
+  std::mt19937_64 random(32);
+  std::uniform_real_distribution<double> jiggle(-0.2 * skin, 0.2 * skin);
+  for (auto& x : moved.position) {
+    for (int a = 0; a < D; ++a) x[a] += jiggle(random);
+  }
+  for (const bool into_cell_order : {false, true}) {
+    SCOPED_TRACE(into_cell_order ? "into cell order" : "kept order");
+    // One thread, one partner at a time: the reference.
+    const NeighbourList<D> one = list_built_twice(start, moved, 1, {}, into_cell_order, false);
+    if (!into_cell_order) {
+      ASSERT_EQ(listed_pairs(one), brute_force_pairs(moved, skin));
+    }
+    std::size_t touching = 0;
+    for (const TouchState t : one.touching()) touching += t == TouchState::touching ? 1 : 0;
+    ASSERT_GT(touching, 0u) << "some histories must be carried for the comparison to mean much";
+    // Even shares, shares far from even, a share with no particle, and shares of another
+    // thread count (ignored: even shares).
+    const std::vector<std::vector<std::uint32_t>> shares_tried = {
+        {}, {0, 200, count}, {0, 2900, count}, {0, 0, count}, {0, 1000, 2000, count}};
+    for (const auto& shares : shares_tried) {
+      SCOPED_TRACE(testing::Message() << "shares of " << shares.size() << " bounds");
+      const NeighbourList<D> two = list_built_twice(start, moved, 2, shares, into_cell_order);
+      ASSERT_EQ(listed_pairs(two), listed_pairs(one));
+      ASSERT_EQ(two.first_begin(), one.first_begin());
+      ASSERT_EQ(two.previous_index(), one.previous_index());
+      ASSERT_EQ(two.reference_position(), one.reference_position());
+      for (std::size_t p = 0; p < one.pair_count(); ++p) {
+        ASSERT_EQ(two.history()[p].dissipated, one.history()[p].dissipated) << "pair " << p;
+        ASSERT_EQ(two.history()[p].normal_spring_origin, one.history()[p].normal_spring_origin);
+        ASSERT_EQ(two.history()[p].tangential_spring, one.history()[p].tangential_spring);
+        ASSERT_EQ(two.touching()[p], one.touching()[p]);
+      }
+    }
+  }
+}
+
+TEST(NeighbourList, SameListAndHistoriesOnAnyThreadsAndSharesDiscs) {
+  check_same_list_for_any_threads_and_shares<2>();
+}
+
+TEST(NeighbourList, SameListAndHistoriesOnAnyThreadsAndSharesSpheres) {
+  check_same_list_for_any_threads_and_shares<3>();
 }
 
 TEST(NeighbourList, EmptyListStaysEmpty) {

@@ -79,6 +79,17 @@ class NeighbourList {
   /// particles (512 instead of 2048). The same list either way.
   void set_parallel(bool parallel) { parallel_ = parallel; }
   bool parallel() const { return parallel_; }
+  /// Where the caller's threads' shares of the particles begin (one per thread, then the
+  /// particle count), if its step splits them so: the rebuild's threads then sort and carry
+  /// the pairs of the same shares, so that each thread's pairs are written by its own core.
+  /// Empty, or of another thread count or particle count: even shares. The same list either
+  /// way.
+  void set_thread_shares(const std::vector<std::uint32_t>& share_begin) {
+    share_begin_ = share_begin;
+  }
+  /// Whether the search may look at four partners at a time where the processor has AVX2 (by
+  /// default it does; the same list either way, which tests check).
+  void set_lane_search(bool on) { lane_search_ = on; }
   /// After a rebuild into cell order, for each new index the particle's index before it.
   const std::vector<std::uint32_t>& previous_index() const { return previous_index_; }
 
@@ -103,7 +114,9 @@ class NeighbourList {
   double next_skin_;
   double period_ = 0.0;
   long rebuild_count_ = 0;
-  bool parallel_ = false;  // set_parallel
+  bool parallel_ = false;                   // set_parallel
+  std::vector<std::uint32_t> share_begin_;  // set_thread_shares
+  bool lane_search_ = true;                 // set_lane_search
   std::vector<std::uint32_t> first_, second_;
   std::vector<ContactHistory<D>> history_;
   std::vector<TouchState> touching_;
@@ -124,8 +137,15 @@ class NeighbourList {
     std::uint32_t first;
     std::uint32_t second;
   };
-  std::vector<std::vector<FoundPair>> found_;  // per search chunk
+  /// The end of rebuild: the found pairs sorted into the new list, the histories carried
+  /// over, the positions kept as the list's reference.
+  void sort_and_carry(const std::vector<Vec<D>>& position, std::size_t count, bool into_cell_order,
+                      bool parallel);
+  std::vector<std::vector<FoundPair>> found_;          // per search chunk
+  std::vector<std::uint32_t> found_low_, found_high_;  // each chunk's lowest and highest first
   std::vector<std::uint32_t> pair_cursor_;
+  std::vector<std::uint32_t> range_end_;  // where each thread's pairs end (sort_and_carry)
+  std::vector<std::uint32_t> next_first_begin_;
   std::vector<ContactHistory<D>> next_history_;
   std::vector<TouchState> next_touching_;
 };

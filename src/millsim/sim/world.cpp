@@ -11,6 +11,7 @@
 #include <memory>
 #include <type_traits>
 
+#include "millsim/core/cpu.hpp"
 #include "millsim/core/prefetch.hpp"
 #include "millsim/core/vector_growth.hpp"
 
@@ -107,19 +108,6 @@ bool splits_among_threads(std::size_t pairs, int threads) {
 /// 1e4-ball slab, 1.5 MB, 2–4 % faster; the 3D 20 k scene and the LIGGGHTS comparison's, 3 MB,
 /// 3–8 % faster; the 1e5-ball slab, 15 MB, +10 % in the eleventh).
 constexpr std::size_t prefetch_threshold_bytes = std::size_t{1} << 20;
-
-/// Whether this processor has AVX2 (asked once).
-bool processor_has_avx2() {
-#if defined(__x86_64__)
-  static const bool has = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") != 0;
-  }();
-  return has;
-#else
-  return false;
-#endif
-}
 
 std::size_t block_count(std::size_t items, std::size_t block) {
   return (items + block - 1) / block;
@@ -219,6 +207,7 @@ void World<D>::refresh_neighbours(bool moved) {
       cell_order_interval_ > 0 && neighbours_.rebuild_count() % cell_order_interval_ == 0;
   // The last list's pairs say whether the step splits among threads.
   neighbours_.set_parallel(splits_among_threads(neighbours_.pair_count(), omp_get_max_threads()));
+  neighbours_.set_thread_shares(split_particle_);
   neighbours_.rebuild(particles_.position, particles_.radius, into_cell_order);
   if (into_cell_order) reorder_particles(neighbours_.previous_index());
   const std::size_t pairs = neighbours_.pair_count();
@@ -234,37 +223,78 @@ void World<D>::refresh_neighbours(bool moved) {
   // it has moved half a skin, which triggers the next rebuild. Each candidate has
   // max_wall_contacts slots of wall-contact history, carried over from the last list if it was
   // a candidate then. One that leaves the list has no wall contact left (it is a skin away);
-  // any slot it still held ends here.
+  // any slot it still held ends here. Each thread lists the candidates among its share of the
+  // particles (the shares of the step's runs), so that their slots are written by the core
+  // that steps them (the 2D SAG scene, two threads: 40 µs a rebuild, against 60 µs on one
+  // thread; bench/results.md).
   constexpr auto slots = static_cast<std::size_t>(max_wall_contacts);
-  wall_candidates_.clear();
-  next_wall_slot_id_.clear();
-  next_wall_slot_history_.clear();
-  // About as many candidates as last time.
-  reserve_with_slack(next_wall_slot_id_, wall_slot_id_.size());
-  reserve_with_slack(next_wall_slot_history_, wall_slot_history_.size());
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::uint32_t held = wall_slots_of_[i];
-    const std::size_t from = static_cast<std::size_t>(held) * slots;
-    if (walls_.may_touch(particles_.position[i], particles_.radius[i], skin)) {
-      wall_slots_of_[i] = static_cast<std::uint32_t>(wall_candidates_.size());
-      wall_candidates_.push_back(static_cast<std::uint32_t>(i));
-      if (held == no_wall_slots) {
-        next_wall_slot_id_.insert(next_wall_slot_id_.end(), slots, -1);
-        next_wall_slot_history_.insert(next_wall_slot_history_.end(), slots, WallHistory{});
-      } else {
-        next_wall_slot_id_.insert(next_wall_slot_id_.end(), &wall_slot_id_[from],
-                                  &wall_slot_id_[from] + slots);
-        next_wall_slot_history_.insert(next_wall_slot_history_.end(), &wall_slot_history_[from],
-                                       &wall_slot_history_[from] + slots);
-      }
-      continue;
+  const bool parallel_candidates =
+      count >=
+      (neighbours_.parallel() ? parallel_candidate_threshold_when_split : parallel_threshold);
+  const std::size_t most =
+      parallel_candidates ? static_cast<std::size_t>(omp_get_max_threads()) : 1;
+  candidate_share_.assign(most + 1, 0);
+  if (leaving_slots_.size() < most) leaving_slots_.resize(most);
+  is_candidate_.resize(count);
+  std::size_t team_size = 1;
+#pragma omp parallel if (parallel_candidates)
+  {
+    const auto team = static_cast<std::size_t>(omp_get_num_threads());
+    const auto t = static_cast<std::size_t>(omp_get_thread_num());
+    const bool as_split = split_particle_.size() == team + 1 && split_particle_[team] == count;
+    const std::size_t low = as_split ? split_particle_[t] : count * t / team;
+    const std::size_t high = as_split ? split_particle_[t + 1] : count * (t + 1) / team;
+    std::uint32_t found = 0;
+    for (std::size_t i = low; i < high; ++i) {
+      const bool candidate = walls_.may_touch(particles_.position[i], particles_.radius[i], skin);
+      is_candidate_[i] = candidate ? 1 : 0;
+      found += candidate ? 1U : 0U;
     }
-    wall_slots_of_[i] = no_wall_slots;
-    if (held == no_wall_slots || spectrum_ == nullptr) continue;
-    for (std::size_t slot = from; slot < from + slots; ++slot) {
-      if (wall_slot_id_[slot] < 0) continue;
-      spectrum_->record(wall_contact_type(walls_.kind_of(wall_slot_id_[slot])),
-                        wall_slot_history_[slot].dissipated);
+    candidate_share_[t + 1] = found;
+#pragma omp barrier
+#pragma omp single
+    {
+      team_size = team;
+      for (std::size_t u = 0; u < team; ++u) candidate_share_[u + 1] += candidate_share_[u];
+      const std::size_t candidates = candidate_share_[team];
+      wall_candidates_.resize(candidates);
+      reserve_with_slack(next_wall_slot_id_, candidates * slots);
+      reserve_with_slack(next_wall_slot_history_, candidates * slots);
+      next_wall_slot_id_.resize(candidates * slots);
+      next_wall_slot_history_.resize(candidates * slots);
+    }
+    std::vector<std::uint32_t>& leaving = leaving_slots_[t];
+    leaving.clear();
+    std::size_t k = candidate_share_[t];
+    for (std::size_t i = low; i < high; ++i) {
+      const std::uint32_t held = wall_slots_of_[i];
+      const std::size_t from = static_cast<std::size_t>(held) * slots;
+      if (is_candidate_[i] == 0) {
+        wall_slots_of_[i] = no_wall_slots;
+        if (held != no_wall_slots) leaving.push_back(held);
+        continue;
+      }
+      wall_slots_of_[i] = static_cast<std::uint32_t>(k);
+      wall_candidates_[k] = static_cast<std::uint32_t>(i);
+      const std::size_t to = k * slots;
+      for (std::size_t slot = 0; slot < slots; ++slot) {
+        next_wall_slot_id_[to + slot] = held == no_wall_slots ? -1 : wall_slot_id_[from + slot];
+        next_wall_slot_history_[to + slot] =
+            held == no_wall_slots ? WallHistory{} : wall_slot_history_[from + slot];
+      }
+      ++k;
+    }
+  }
+  candidate_share_.resize(team_size + 1);
+  // The collisions of the particles that left, in particle order.
+  for (std::size_t t = 0; t < team_size && spectrum_ != nullptr; ++t) {
+    for (const std::uint32_t held : leaving_slots_[t]) {
+      const std::size_t from = static_cast<std::size_t>(held) * slots;
+      for (std::size_t slot = from; slot < from + slots; ++slot) {
+        if (wall_slot_id_[slot] < 0) continue;
+        spectrum_->record(wall_contact_type(walls_.kind_of(wall_slot_id_[slot])),
+                          wall_slot_history_[slot].dissipated);
+      }
     }
   }
   wall_slot_id_.swap(next_wall_slot_id_);
@@ -318,12 +348,21 @@ void World<D>::refresh_nearby_lifters() {
   const bool parallel =
       candidates >=
       (neighbours_.parallel() ? parallel_candidate_threshold_when_split : parallel_threshold);
-#pragma omp parallel for schedule(static) if (parallel)
-  for (std::size_t k = 0; k < candidates; ++k) {
-    const std::size_t i = wall_candidates_[k];
-    const Vec<D>& x = particles_.position[i];
-    const double reach = rounding * (particles_.radius[i] + skin + lifter_travel_);
-    nearby_lifters_[k] = nearby_lifters(mill, Vec2{{x[0], x[1]}}, reach);
+  // Each thread the candidates it listed at the last rebuild (refresh_neighbours).
+#pragma omp parallel if (parallel)
+  {
+    const auto team = static_cast<std::size_t>(omp_get_num_threads());
+    const auto t = static_cast<std::size_t>(omp_get_thread_num());
+    const bool as_listed =
+        candidate_share_.size() == team + 1 && candidate_share_[team] == candidates;
+    const std::size_t low = as_listed ? candidate_share_[t] : candidates * t / team;
+    const std::size_t high = as_listed ? candidate_share_[t + 1] : candidates * (t + 1) / team;
+    for (std::size_t k = low; k < high; ++k) {
+      const std::size_t i = wall_candidates_[k];
+      const Vec<D>& x = particles_.position[i];
+      const double reach = rounding * (particles_.radius[i] + skin + lifter_travel_);
+      nearby_lifters_[k] = nearby_lifters(mill, Vec2{{x[0], x[1]}}, reach);
+    }
   }
 }
 

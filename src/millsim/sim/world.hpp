@@ -527,6 +527,11 @@ class World {
   std::vector<std::int32_t> wall_slot_id_, next_wall_slot_id_;
   std::vector<WallHistory> wall_slot_history_, next_wall_slot_history_;
   std::vector<std::uint32_t> wall_slots_of_;
+  // Scratch of the candidates' listing: where each thread's candidates begin (and, last, how
+  // many there are), which particles are candidates, and the slots of those that left.
+  std::vector<std::uint32_t> candidate_share_;
+  std::vector<std::uint8_t> is_candidate_;
+  std::vector<std::vector<std::uint32_t>> leaving_slots_;
   // Per wall candidate, the lifters it may touch until the next rebuild or until the lifters
   // have moved lifter_travel_ (arc length at the shell) since they were listed, at mill angle
   // nearby_lifter_angle_ (refresh_nearby_lifters).
