@@ -371,6 +371,18 @@ Vec<D> tangential_force_on_second(const ContactHistory<D>& h, const Vec<D>& n) {
   }
 }
 
+/// Writes the marker m into every field of a history (in 3D a spring along no axis).
+template <int D>
+void mark_history(ContactHistory<D>& h, double m) {
+  h.dissipated = m;
+  h.normal_spring_origin = -m;
+  if constexpr (D == 2) {
+    h.tangential_spring = 3.0 * m;
+  } else {
+    h.tangential_spring = Vec3{{3.0 * m, -2.0 * m, 0.5 * m}};
+  }
+}
+
 template <int D>
 void check_history_carried_into_cell_order() {
   const Cloud<D> cloud = random_cloud<D>(cloud_size, box_side<D>, 23);
@@ -393,13 +405,7 @@ void check_history_carried_into_cell_order() {
     const std::uint32_t b = list.second()[p];
     const double m = 1000.0 + static_cast<double>(p);
     ContactHistory<D>& h = list.history()[p];
-    h.dissipated = m;
-    h.normal_spring_origin = -m;
-    if constexpr (D == 2) {
-      h.tangential_spring = 3.0 * m;
-    } else {
-      h.tangential_spring = Vec3{{3.0 * m, -2.0 * m, 0.5 * m}};
-    }
+    mark_history(h, m);
     list.touching()[p] = TouchState::touching;
     marked[{a, b}] = {m, tangential_force_on_second(h, normal(a, b))};
   }
@@ -464,13 +470,7 @@ NeighbourList<D> list_built_twice(const Cloud<D>& start, const Cloud<D>& moved, 
     const double m = 1000.0 + static_cast<double>(list.first()[p]) +
                      1e-4 * static_cast<double>(list.second()[p]);
     ContactHistory<D>& h = list.history()[p];
-    h.dissipated = m;
-    h.normal_spring_origin = -m;
-    if constexpr (D == 2) {
-      h.tangential_spring = 3.0 * m;
-    } else {
-      h.tangential_spring = Vec3{{3.0 * m, -2.0 * m, 0.5 * m}};
-    }
+    mark_history(h, m);
     list.touching()[p] = p % 3 == 0 ? TouchState::touching : TouchState::apart;
   }
   list.rebuild(moved.position, moved.radius, into_cell_order);
