@@ -459,6 +459,48 @@ TEST(Determinism, SparseGasOfManyDiscsIsTheSameOnOneAndTwoThreads) {
   EXPECT_GT(one.world.neighbour_rebuilds(), 1);
 }
 
+TEST(Determinism, ChargeOfOneMassGivesTheBitsOfDashpotsWorkedOutForEachContact) {
+  // In a charge of one ball size the pair and wall kernels take the dashpots' coefficients
+  // made once (World::set_uniform_mass_shortcut); they are the bits worked out for each contact
+  // from the two masses. The short 3D mill with end plates (balls of 1 cm): pairs and walls.
+  const MillPlan plan =
+      plan_mill(parse_mill_config(short_wide_mill(false), "short-wide-mill.toml"));
+  const World<3> scene = moving_scene<3>(plan, 0.0, 1.0, 4.0, 200);
+  const Outcome<3> shortcut = step_on(scene, 300, 1);
+  EXPECT_TRUE(shortcut.world.uniform_mass());
+  for (const int threads : {1, 2}) {
+    const ThreadCount thread_count(threads);
+    Outcome<3> worked_out{scene, ImpactSpectrum{}, threads};
+    worked_out.world.set_uniform_mass_shortcut(false);
+    EXPECT_FALSE(worked_out.world.uniform_mass());
+    worked_out.world.record_collisions_in(&worked_out.spectrum);
+    for (int n = 0; n < 300; ++n) worked_out.world.step();
+    worked_out.world.record_collisions_in(nullptr);
+    EXPECT_FALSE(worked_out.world.uniform_mass());
+    expect_identical(shortcut, worked_out);
+  }
+  EXPECT_GT(shortcut.world.touching_contacts(), 100u);
+  EXPECT_GT(shortcut.spectrum.total_count(ContactType::ball_end_plate), 100);
+
+  // A mass changed through particles() is seen at the next step, and so is its undoing.
+  World<3> world = scene;
+  world.step();
+  EXPECT_TRUE(world.uniform_mass());
+  const double mass = world.particles().mass[0];
+  world.particles().mass[0] = 1.5 * mass;
+  world.step();
+  EXPECT_FALSE(world.uniform_mass());
+  world.particles().mass[0] = mass;
+  world.step();
+  EXPECT_TRUE(world.uniform_mass());
+  // The 2D SAG scene's charge has six sizes.
+  const MillPlan sag = plan_mill(load_mill_config(
+      std::string(MILLSIM_SOURCE_DIR) + "/bench/sag-12m-2d.toml", {"output.snapshot_interval=0"}));
+  World<2> graded = build_mill_world<2>(sag);
+  graded.step();
+  EXPECT_FALSE(graded.uniform_mass());
+}
+
 /// Steps a copy of `scene` `steps` times on two threads; halfway, sets one particle's velocity
 /// and spin through World::particles(). With `ask_every_step`, particles() is also asked for
 /// before every step, so that every step makes its velocity estimates from the particles

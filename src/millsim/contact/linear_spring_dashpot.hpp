@@ -37,6 +37,7 @@ class LinearSpringDashpot {
         damping_ratio_(damping_ratio(material.restitution)),
         sqrt_normal_stiffness_(std::sqrt(material.normal_stiffness)),
         sqrt_tangential_stiffness_(std::sqrt(material.tangential_stiffness)),
+        half_tangential_compliance_(0.5 / material.tangential_stiffness),
         friction_(material.friction),
         allow_tension_(allow_tension) {}
 
@@ -133,9 +134,9 @@ class LinearSpringDashpot {
     const Mask<T> slips = lane_abs(trial) > friction_limit;
     const T slipping_spring = lane_copysign(friction_limit, trial);
     const T slipping_dissipated =
-        dashpot_dissipated +
-        (-dt * (slipping_spring * sliding) +
-         (spring_before * spring_before - slipping_spring * slipping_spring) / (2.0 * k_s));
+        dashpot_dissipated + (-dt * (slipping_spring * sliding) +
+                              (spring_before * spring_before - slipping_spring * slipping_spring) *
+                                  splat<T>(half_tangential_compliance_));
     const T sticking_dissipated =
         dashpot_dissipated + tangential_damping * (sliding * sliding) * dt;
     const T tangential = select(slips, slipping_spring, trial);
@@ -209,9 +210,9 @@ class LinearSpringDashpot {
     // cancel: 4 % of the power of a 3D mill.) In steady sliding it is μ F_N |v_s| Δt.
     const V slipping_spring = trial * (friction_limit / lane_sqrt(trial_length_squared));
     const T slipping_dissipated =
-        dashpot_dissipated +
-        (-dt * dot(slipping_spring, sliding_velocity) +
-         (norm_squared(spring_before) - norm_squared(slipping_spring)) / (2.0 * k_s));
+        dashpot_dissipated + (-dt * dot(slipping_spring, sliding_velocity) +
+                              (norm_squared(spring_before) - norm_squared(slipping_spring)) *
+                                  splat<T>(half_tangential_compliance_));
     // Sticking: the dashpot dissipates c_s |v_s|² Δt.
     const T sticking_dissipated =
         dashpot_dissipated + tangential_damping * norm_squared(sliding_velocity) * dt;
@@ -258,6 +259,11 @@ class LinearSpringDashpot {
   double damping_ratio_;
   double sqrt_normal_stiffness_;
   double sqrt_tangential_stiffness_;
+  /// 1 / (2 k_s): the energy a slipping contact's spring gives up is worked out for every
+  /// contact (without branches), and multiplying by it spares the divider, which the law waits
+  /// on, one of its operations in every step (the last bit of that energy may differ from a
+  /// division's; the forces do not depend on it).
+  double half_tangential_compliance_;
   double friction_;
   bool allow_tension_;
 };

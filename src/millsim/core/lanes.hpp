@@ -43,9 +43,21 @@ template <class M, int D, class T>
 }
 template <class M>
 [[gnu::always_inline]] inline bool any(M mask) {
-  auto bits = mask[0];
-  for (int l = 1; l < lane_count; ++l) bits |= mask[l];
-  return bits != 0;
+  // Halves folded in the vector unit (a loop over the lanes compiled to an extraction each).
+  static_assert(lane_count == 4);
+  const M folded = mask | __builtin_shufflevector(mask, mask, 2, 3, 0, 1);
+  return (folded[0] | folded[1]) != 0;
+}
+
+/// Whether the mask holds in every lane (for bool, the mask itself).
+[[gnu::always_inline]] inline bool all(bool mask) {
+  return mask;
+}
+template <class M>
+[[gnu::always_inline]] inline bool all(M mask) {
+  static_assert(lane_count == 4);
+  const M folded = mask & __builtin_shufflevector(mask, mask, 2, 3, 0, 1);
+  return (folded[0] & folded[1]) != 0;
 }
 
 /// Square root and absolute value, exact in every lane as std::sqrt and std::abs are.

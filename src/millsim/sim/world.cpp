@@ -170,6 +170,7 @@ void World<D>::step() {
     check_estimates_made();
   } else {
     moved = estimate_current_velocities();
+    check_uniform_mass();
   }
   refresh_neighbours(moved);
   if (stages_on_one_thread()) {
@@ -396,6 +397,19 @@ void World<D>::reorder_particles(const std::vector<std::uint32_t>& previous) {
   for (std::size_t k = 0; k < particle_id_.size(); ++k) {
     particle_index_[particle_id_[k]] = static_cast<std::uint32_t>(k);
   }
+}
+
+template <int D>
+void World<D>::check_uniform_mass() {
+  const std::vector<double>& mass = particles_.mass;
+  uniform_mass_ =
+      uniform_mass_shortcut_ && !mass.empty() &&
+      std::all_of(mass.begin(), mass.end(), [&](double m) { return m == mass.front(); });
+  if (!uniform_mass_) return;
+  // As the kernels would work them out from the two masses (the same operations).
+  const double m = mass.front();
+  uniform_pair_damping_ = ball_ball_law_.damping(m * m / (m + m));
+  uniform_wall_damping_ = ball_wall_law_.damping(m);
 }
 
 template <int D>
@@ -872,7 +886,12 @@ void World<D>::evaluate_listed_pairs(std::size_t block, const std::uint32_t* lis
     return;
   }
 #endif
-  evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, each_apart);
+  // Compiled for each value of each_apart (the kernel is inlined), so that no pair asks.
+  if (each_apart) {
+    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, true);
+  } else {
+    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, false);
+  }
 }
 
 #if defined(__x86_64__)
@@ -880,7 +899,11 @@ template <int D>
 void World<D>::evaluate_listed_pairs_avx2(std::size_t block, const std::uint32_t* listed,
                                           std::size_t count, double& dissipated,
                                           std::uint32_t& ended, bool each_apart) {
-  evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, each_apart);
+  if (each_apart) {
+    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, true);
+  } else {
+    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, false);
+  }
 }
 #endif
 
@@ -895,7 +918,7 @@ void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, st
       __builtin_prefetch(&spin_now_[i]);
       __builtin_prefetch(&p.velocity[i]);
       __builtin_prefetch(&p.angular_velocity[i]);
-      __builtin_prefetch(&p.mass[i]);
+      if (!uniform_mass_) __builtin_prefetch(&p.mass[i]);
       __builtin_prefetch(&p.force[i], 1);
       __builtin_prefetch(&p.torque[i], 1);
     }
@@ -991,20 +1014,31 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
                                            return r[i[l]] * p.angular_velocity[i[l]] +
                                                   r[j[l]] * p.angular_velocity[j[l]];
                                          }));
-    const T mass_i = gather_lanes([&](std::size_t l) { return p.mass[i[l]]; });
-    const T mass_j = gather_lanes([&](std::size_t l) { return p.mass[j[l]]; });
+
     ContactHistory<D, T> held;
     held.normal_spring_origin =
         gather_lanes([&](std::size_t l) { return history[q[l]].normal_spring_origin; });
     held.tangential_spring =
         gather_spin_lanes<D>([&](std::size_t l) { return history[q[l]].tangential_spring; });
     held.dissipated = gather_lanes([&](std::size_t l) { return history[q[l]].dissipated; });
-    const ContactDampingOf<T> damping = ball_ball_law_.damping(mass_i * mass_j / (mass_i + mass_j));
+    ContactDampingOf<T> damping;
+    if (uniform_mass_) {
+      damping.normal = splat<T>(uniform_pair_damping_.normal);
+      damping.tangential = splat<T>(uniform_pair_damping_.tangential);
+    } else {
+      const T mass_i = gather_lanes([&](std::size_t l) { return p.mass[i[l]]; });
+      const T mass_j = gather_lanes([&](std::size_t l) { return p.mass[j[l]]; });
+      damping = ball_ball_law_.damping(mass_i * mass_j / (mass_i + mass_j));
+    }
     const ContactOutput<D, T> out = ball_ball_law_.evaluate(in, damping, held, dt);
     const auto moment = -cross(in.normal, out.tangential_force);
 
     // Each pair's outcome, in pair order: a pair that no longer overlaps has ended (it is
-    // listed, so it touched until now); the others add their forces.
+    // listed, so it touched until now); the others add their forces. Most groups are four
+    // pairs that all touch: for them the same operations in the same order, without asking
+    // each pair (a loop of four the compiler unrolls, each lane's values taken from its
+    // registers).
+    const bool all_touch = filled == lanes && all(overlaps);
     if constexpr (D == 2) {
       // The histories of the four lanes, written without a branch after the ended pairs'
       // energies are read: those of ended pairs zeroed, the rest the law's (a lane that repeats
@@ -1013,19 +1047,25 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
       // build, from AVX2 code into baseline code: core/vec.hpp.)
       const T zero{};
       const std::array<Pair2, lanes> force_of = pairs_of(out.force);
-      for (std::size_t l = 0; l < filled; ++l) {
-        const std::uint32_t pair = q[l];
-        if (overlaps[l] == 0) {
-          record_pair_end(pair, history[pair].dissipated, begin, ended, each_apart);
-          touching[pair] = TouchState::apart;
-          continue;
-        }
-        touching[pair] = TouchState::touching;
+      const auto touches = [&](std::size_t l) __attribute__((always_inline)) {
+        touching[q[l]] = TouchState::touching;
         subtract_from(particles_.force[i[l]], force_of[l]);
         add_to(particles_.force[j[l]], force_of[l]);
         particles_.torque[i[l]] += r[i[l]] * moment[l];
         particles_.torque[j[l]] += r[j[l]] * moment[l];
-        record_pair_touch(pair, out.dissipated[l], dissipated, each_apart);
+        record_pair_touch(q[l], out.dissipated[l], dissipated, each_apart);
+      };
+      if (all_touch) {
+        for (std::size_t l = 0; l < lanes; ++l) touches(l);
+      } else {
+        for (std::size_t l = 0; l < filled; ++l) {
+          if (overlaps[l] == 0) {
+            record_pair_end(q[l], history[q[l]].dissipated, begin, ended, each_apart);
+            touching[q[l]] = TouchState::apart;
+            continue;
+          }
+          touches(l);
+        }
       }
       const T origin = select(overlaps, held.normal_spring_origin, zero);
       const T spring = select(overlaps, held.tangential_spring, zero);
@@ -1037,14 +1077,8 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
         h.dissipated = energy[l];
       }
     } else {
-      for (std::size_t l = 0; l < filled; ++l) {
+      const auto touches = [&](std::size_t l) __attribute__((always_inline)) {
         const std::uint32_t pair = q[l];
-        if (overlaps[l] == 0) {
-          record_pair_end(pair, history[pair].dissipated, begin, ended, each_apart);
-          history[pair] = ContactHistory<D>{};
-          touching[pair] = TouchState::apart;
-          continue;
-        }
         touching[pair] = TouchState::touching;
         ContactHistory<D>& h = history[pair];
         h.normal_spring_origin = held.normal_spring_origin[l];
@@ -1059,6 +1093,19 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
         particles_.torque[i[l]] += r[i[l]] * turn;
         particles_.torque[j[l]] += r[j[l]] * turn;
         record_pair_touch(pair, out.dissipated[l], dissipated, each_apart);
+      };
+      if (all_touch) {
+        for (std::size_t l = 0; l < lanes; ++l) touches(l);
+      } else {
+        for (std::size_t l = 0; l < filled; ++l) {
+          if (overlaps[l] == 0) {
+            record_pair_end(q[l], history[q[l]].dissipated, begin, ended, each_apart);
+            history[q[l]] = ContactHistory<D>{};
+            touching[q[l]] = TouchState::apart;
+            continue;
+          }
+          touches(l);
+        }
       }
     }
   }
@@ -1295,10 +1342,16 @@ void World<D>::evaluate_wall_laws_in_lanes(const WallContact<D>* contact, WallWo
         spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
                        return p.radius[particle(l)] * p.angular_velocity[particle(l)];
                      }));
-    // The dashpots' coefficients from the particle's mass (m* = m against a wall), worked out
-    // here as the pair kernel does, not kept per particle.
-    const ContactDampingOf<T> damping =
-        ball_wall_law_.damping(gather_lanes([&](std::size_t l) { return p.mass[particle(l)]; }));
+    // The dashpots' coefficients from the particle's mass (m* = m against a wall), as the pair
+    // kernel has them (the same for every particle of a charge of one size).
+    ContactDampingOf<T> damping;
+    if (uniform_mass_) {
+      damping.normal = splat<T>(uniform_wall_damping_.normal);
+      damping.tangential = splat<T>(uniform_wall_damping_.tangential);
+    } else {
+      damping =
+          ball_wall_law_.damping(gather_lanes([&](std::size_t l) { return p.mass[particle(l)]; }));
+    }
     ContactHistory<D, T> held;
     const auto history = [&](std::size_t l) -> WallHistory& {
       return wall_slot_history_[c[l]->slot];

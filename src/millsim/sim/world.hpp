@@ -179,6 +179,16 @@ class World {
   /// results are the same bit for bit either way; tests switch it off to show that.
   void set_avx2_lanes(bool on);
   bool avx2_lanes() const { return avx2_lanes_; }
+  /// Whether, when every particle has the same mass (a charge of one ball size), the pair and
+  /// wall kernels take the dashpots' coefficients made once for that mass (the default), or
+  /// work them out for each contact as for a charge of several sizes. The same bits either way;
+  /// tests switch it off to show that.
+  void set_uniform_mass_shortcut(bool on) {
+    uniform_mass_shortcut_ = on;
+    check_uniform_mass();
+  }
+  /// Whether the kernels take that shortcut now (as of the last step).
+  bool uniform_mass() const { return uniform_mass_; }
   /// How often the lists of nearby lifters were made, at rebuilds and because the mill had
   /// turned too far since.
   long nearby_lifter_refreshes() const { return nearby_lifter_refreshes_; }
@@ -423,6 +433,12 @@ class World {
   /// Period of the mill's axis when it is a periodic slab, else 0.
   double axial_period() const;
 
+  /// Whether every particle has the same mass (a charge of one ball size), and if so the
+  /// dashpots' coefficients of every pair and of every wall contact, the same bits
+  /// LinearSpringDashpot::damping gives from the masses. Made again whenever the particles may
+  /// have changed.
+  void check_uniform_mass();
+
   /// A collision that ended in a parallel stage, recorded in the spectrum after it in a fixed
   /// order (blocks in order, then in the order they were found), so any thread count gives the
   /// same spectrum.
@@ -448,6 +464,14 @@ class World {
   // work the leapfrog update does (docs/model.md, "energy account").
   std::vector<Vec<D>> velocity_now_;
   std::vector<Spin<D>> spin_now_;
+  // Particles all of one mass (check_uniform_mass): the kernels then take the dashpots'
+  // coefficients as they are instead of working them out for each contact and step (a square
+  // root and two divisions for four contacts, which the 3D law waits on). A charge of several
+  // sizes works them out: looking them up by the two sizes took as long (bench/results.md).
+  bool uniform_mass_ = false;
+  bool uniform_mass_shortcut_ = true;
+  ContactDamping uniform_pair_damping_;
+  ContactDamping uniform_wall_damping_;
   // Whether velocity_now_ and spin_now_ are those of the particles now, made by the last step's
   // integration in the same pass (saving a pass over the particle arrays, which in 3D lie
   // beyond the second-level cache), and whether a particle had then moved half a skin. Cleared
