@@ -218,10 +218,11 @@ ArrayEstimate estimate_array_bytes(const millsim::World<D>& world) {
   // energy.
   const double world_per_pair =
       2 * sizeof(double) + (omp_get_max_threads() > 1 ? 1.0 + sizeof(double) : 0.0);
-  // first, second and their rebuild copies, the search's found pair, the history and the
-  // touching flag and their rebuild copies.
+  // first, second and their rebuild copies, the search's found pair, the history, the
+  // touching flag and the reach and their rebuild copies.
   constexpr double search_per_pair =
-      4 * index + 2 * index + 2 * (sizeof(ContactHistory<D>) + sizeof(millsim::TouchState));
+      4 * index + 2 * index +
+      2 * (sizeof(ContactHistory<D>) + sizeof(millsim::TouchState) + sizeof(double));
   ArrayEstimate estimate;
   estimate.pairs_per_particle = pairs / std::max(1.0, particles);
   estimate.bytes_per_particle = store + world_per_particle + search_per_particle +

@@ -407,11 +407,12 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       found_high_[chunk] = high_first;
     }
   }
-  sort_and_carry(position, count, into_cell_order, parallel);
+  sort_and_carry(position, radius, count, into_cell_order, parallel);
 }
 
 template <int D>
-void NeighbourList<D>::sort_and_carry(const std::vector<Vec<D>>& position, std::size_t count,
+void NeighbourList<D>::sort_and_carry(const std::vector<Vec<D>>& position,
+                                      const std::vector<double>& radius, std::size_t count,
                                       bool into_cell_order, bool parallel) {
   // The pairs sorted by (first, second): a counting sort by first, then each first's seconds.
   // Then the history of each pair kept from the old list, found among the old pairs of the
@@ -466,10 +467,12 @@ void NeighbourList<D>::sort_and_carry(const std::vector<Vec<D>>& position, std::
       reserve_with_slack(next_second_, pairs);
       reserve_with_slack(next_history_, pairs);
       reserve_with_slack(next_touching_, pairs);
+      reserve_with_slack(next_reach_, pairs);
       next_first_.resize(pairs);
       next_second_.resize(pairs);
       next_history_.resize(pairs);
       next_touching_.resize(pairs);
+      next_reach_.resize(pairs);
     }
     const std::uint32_t pairs_begin = range_end_[t];
     const std::uint32_t pairs_end = range_end_[t + 1];
@@ -527,6 +530,11 @@ void NeighbourList<D>::sort_and_carry(const std::vector<Vec<D>>& position, std::
       next_history_[p] = carried;
       next_touching_[p] = touched;
     }
+    // The pairs' reach, from the radii in the new numbering.
+    const double* const r = into_cell_order ? cell_radius_.data() : radius.data();
+    for (std::size_t p = pairs_begin; p < pairs_end; ++p) {
+      next_reach_[p] = r[next_first_[p]] + r[next_second_[p]];
+    }
     for (std::size_t i = low; i < high; ++i) {
       reference_position_[i] = into_cell_order ? cell_position_[i] : position[i];
     }
@@ -535,6 +543,7 @@ void NeighbourList<D>::sort_and_carry(const std::vector<Vec<D>>& position, std::
   second_.swap(next_second_);
   history_.swap(next_history_);
   touching_.swap(next_touching_);
+  reach_.swap(next_reach_);
   first_begin_.swap(next_first_begin_);
 }
 

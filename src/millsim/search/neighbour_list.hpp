@@ -103,6 +103,11 @@ class NeighbourList {
   /// listed pairs) reads one byte, not a history record.
   std::vector<TouchState>& touching() { return touching_; }
   const std::vector<TouchState>& touching() const { return touching_; }
+  /// Per pair, the sum of its two radii as they were at the rebuild (which the list's cut-offs
+  /// take as fixed too): the distance at which the pair touches, r_i + r_j. Kept beside the
+  /// pairs, so that the step's distance test of every listed pair reads it in sequence instead
+  /// of gathering two radii (on the 2D SAG scene's one thread a fifth of that test's time).
+  const std::vector<double>& reach() const { return reach_; }
   /// Pairs of particle i as the first: [first_begin()[i], first_begin()[i + 1]).
   const std::vector<std::uint32_t>& first_begin() const { return first_begin_; }
   long rebuild_count() const { return rebuild_count_; }
@@ -120,6 +125,7 @@ class NeighbourList {
   std::vector<std::uint32_t> first_, second_;
   std::vector<ContactHistory<D>> history_;
   std::vector<TouchState> touching_;
+  std::vector<double> reach_;
   std::vector<std::uint32_t> first_begin_;
   std::vector<Vec<D>> reference_position_;
   // Scratch kept between rebuilds so that a rebuild allocates nothing in steady state.
@@ -139,8 +145,8 @@ class NeighbourList {
   };
   /// The end of rebuild: the found pairs sorted into the new list, the histories carried
   /// over, the positions kept as the list's reference.
-  void sort_and_carry(const std::vector<Vec<D>>& position, std::size_t count, bool into_cell_order,
-                      bool parallel);
+  void sort_and_carry(const std::vector<Vec<D>>& position, const std::vector<double>& radius,
+                      std::size_t count, bool into_cell_order, bool parallel);
   std::vector<std::vector<FoundPair>> found_;          // per search chunk
   std::vector<std::uint32_t> found_low_, found_high_;  // each chunk's lowest and highest first
   std::vector<std::uint32_t> pair_cursor_;
@@ -148,6 +154,7 @@ class NeighbourList {
   std::vector<std::uint32_t> next_first_begin_;
   std::vector<ContactHistory<D>> next_history_;
   std::vector<TouchState> next_touching_;
+  std::vector<double> next_reach_;
 };
 
 extern template class NeighbourList<2>;

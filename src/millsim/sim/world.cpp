@@ -652,7 +652,7 @@ typename World<D>::PairOutcome World<D>::evaluate_pair(std::size_t q, PairForce&
   const std::uint32_t j = neighbours_.second()[q];
   const Vec<D> offset = neighbours_.separation(x[i], x[j]);
   const double distance_squared = norm_squared(offset);
-  const double reach = r[i] + r[j];
+  const double reach = neighbours_.reach()[q];
   if (distance_squared >= reach * reach) {
     if (touching[q] == TouchState::apart) return {PairStatus::apart, 0.0};
     const double energy = history[q].dissipated;
@@ -758,7 +758,7 @@ std::size_t World<D>::list_pairs_avx2(std::size_t begin, std::size_t end,
     const auto& first = neighbours_.first();
     const auto& second = neighbours_.second();
     const auto& x = particles_.position;
-    const auto& r = particles_.radius;
+    const double* const pair_reach = neighbours_.reach().data();
     const TouchState* touching = neighbours_.touching().data();
     static_assert(static_cast<std::uint8_t>(TouchState::apart) == 0 &&
                   static_cast<std::uint8_t>(TouchState::touching) == 1);
@@ -782,7 +782,8 @@ std::size_t World<D>::list_pairs_avx2(std::size_t begin, std::size_t end,
         const Lanes dz = gather_lanes([&](std::size_t l) { return x[j[l]][2] - x[i[l]][2]; });
         distance_squared = (planar[0] * planar[0] + planar[1] * planar[1]) + dz * dz;
       }
-      const Lanes reach = gather_lanes([&](std::size_t l) { return r[i[l]] + r[j[l]]; });
+      Lanes reach;
+      std::memcpy(&reach, pair_reach + q, sizeof reach);
       auto keep = static_cast<unsigned>(
           __builtin_ia32_movmskpd256(reinterpret_cast<Lanes>(distance_squared < reach * reach)));
       // The four pairs' touch states, one byte each (0 or 1), gathered into bits 24 to 27.
@@ -810,7 +811,7 @@ std::size_t World<D>::list_pairs_of(std::size_t begin, std::size_t end, std::siz
   const auto& second = neighbours_.second();
   const auto& touching = neighbours_.touching();
   const auto& x = particles_.position;
-  const auto& r = particles_.radius;
+  const auto& pair_reach = neighbours_.reach();
   // Pairs that overlap now or did until now, in pair order: the rest need nothing. Listed
   // without a branch (a third of the 2D SAG scene's listed pairs touch, scattered among the
   // others, which the processor could only mispredict).
@@ -850,7 +851,7 @@ std::size_t World<D>::list_pairs_of(std::size_t begin, std::size_t end, std::siz
       const double dz = x[j][2] - x[i][2];
       distance_squared = (squares[0] + squares[1]) + dz * dz;
     }
-    const double reach = r[i] + r[j];
+    const double reach = pair_reach[q];
     const unsigned keep = ((distance_squared < reach * reach ? 1U : 0U) |
                            (touching[q] == TouchState::touching ? 1U : 0U)) &
                           own;
