@@ -58,17 +58,30 @@ __attribute__((target("avx2"))) inline unsigned mask_bits(Mask<Lanes> mask) {
   return static_cast<unsigned>(__builtin_ia32_movmskpd256(reinterpret_cast<Lanes>(mask)));
 }
 
-/// The search of one row of cells, [begin, end) in the cell order, four partners at a time:
-/// the scalar loop of NeighbourList::rebuild's visit_row, the same operations on each lane, so
-/// the same pairs in the same order. The pairs go to `found` (two words each, lower index
-/// first), four at a time: it must have room for the row rounded up to four, and the arrays
-/// three entries beyond `end` (their values unused). Gives the number found. Along a periodic
-/// last axis (period > 0), the nearest image's offset, as NeighbourList::separation takes it.
+/// A row of cells to search: the slots [begin, end) of the cells' arrays.
+struct SlotRange {
+  std::uint32_t begin;
+  std::uint32_t end;
+};
+/// How many rows NeighbourList::rebuild hands search_rows_avx2 at most at once.
+constexpr std::size_t rows_at_once = 16;
+
+/// The search of rows of cells (each [begin, end) in the cell order) from one particle, four
+/// partners at a time: the scalar loop of NeighbourList::rebuild's visit_row, the same
+/// operations on each lane, so the same pairs in the same order. One call for all of a
+/// particle's rows (rows_at_once at most), not one a row: rows hold four candidates on average
+/// in the 2D SAG scene, and the call and its set-up cost a quarter of the search's
+/// instructions when it was made for each. The pairs go to `found` (two words each, lower
+/// index first), four at a time: it must have room for the rows' candidates and three more,
+/// and the arrays three entries beyond each row's end (their values unused). Gives the number
+/// found. Along a periodic last axis (period > 0), the nearest image's offset, as
+/// NeighbourList::separation takes it.
 template <int D>
-__attribute__((target("avx2"))) std::size_t search_row_avx2(
+__attribute__((target("avx2"))) std::size_t search_rows_avx2(
     const Vec<D>& own_position, double own_radius, std::uint32_t own, std::uint32_t slot,
     double skin, double period, const Vec<D>* position, const double* radius,
-    const std::uint32_t* member, std::uint32_t begin, std::uint32_t end, std::uint32_t* found) {
+    const std::uint32_t* member, const SlotRange* rows, std::size_t row_count,
+    std::uint32_t* found) {
   const Lanes period_l = splat<Lanes>(period);
   // nearest_integer in each lane: the same operations.
   const Lanes two_to_52 = splat<Lanes>(4503599627370496.0);
@@ -85,56 +98,60 @@ __attribute__((target("avx2"))) std::size_t search_row_avx2(
   for (int a = 0; a < D; ++a) own_x[a] = splat<Lanes>(own_position[a]);
   const FourIndices own_index = {own, own, own, own};
   const FourIndices own_slot = {slot, slot, slot, slot};
-  const FourIndices row_end = {end, end, end, end};
   std::size_t n = 0;
-  for (std::uint32_t k = begin; k < end; k += 4) {
-    Lanes other_radius;
-    std::memcpy(&other_radius, radius + k, sizeof other_radius);
-    Lanes distance_squared;
-    if constexpr (D == 2) {
-      Lanes a;
-      Lanes b;
-      std::memcpy(&a, position[k].c.data(), sizeof a);      // x0 y0 x1 y1
-      std::memcpy(&b, position[k + 2].c.data(), sizeof b);  // x2 y2 x3 y3
-      const Lanes dx = __builtin_shufflevector(a, b, 0, 2, 4, 6) - own_x[0];
-      Lanes dy = __builtin_shufflevector(a, b, 1, 3, 5, 7) - own_x[1];
-      if (periodic) dy = nearest_image(dy);
-      distance_squared = dx * dx + dy * dy;
-    } else {
-      Lanes q0;
-      Lanes q1;
-      Lanes q2;
-      const double* p = position[k].c.data();
-      std::memcpy(&q0, p, sizeof q0);                                  // x0 y0 z0 x1
-      std::memcpy(&q1, p + 4, sizeof q1);                              // y1 z1 x2 y2
-      std::memcpy(&q2, p + 8, sizeof q2);                              // z2 x3 y3 z3
-      const Lanes xy01 = __builtin_shufflevector(q0, q1, 0, 3, 6, 1);  // x0 x1 x2 y0
-      const Lanes yz01 = __builtin_shufflevector(q0, q1, 1, 4, 7, 2);  // y0 y1 y2 z0
-      const Lanes zs01 = __builtin_shufflevector(q0, q1, 2, 5, 0, 0);  // z0 z1 . .
-      const Lanes dx = __builtin_shufflevector(xy01, q2, 0, 1, 2, 5) - own_x[0];
-      const Lanes dy = __builtin_shufflevector(yz01, q2, 0, 1, 2, 6) - own_x[1];
-      Lanes dz = __builtin_shufflevector(zs01, q2, 0, 1, 4, 7) - own_x[2];
-      if (periodic) dz = nearest_image(dz);
-      distance_squared = (dx * dx + dy * dy) + dz * dz;
+  for (std::size_t row = 0; row < row_count; ++row) {
+    const std::uint32_t begin = rows[row].begin;
+    const std::uint32_t end = rows[row].end;
+    const FourIndices row_end = {end, end, end, end};
+    for (std::uint32_t k = begin; k < end; k += 4) {
+      Lanes other_radius;
+      std::memcpy(&other_radius, radius + k, sizeof other_radius);
+      Lanes distance_squared;
+      if constexpr (D == 2) {
+        Lanes a;
+        Lanes b;
+        std::memcpy(&a, position[k].c.data(), sizeof a);      // x0 y0 x1 y1
+        std::memcpy(&b, position[k + 2].c.data(), sizeof b);  // x2 y2 x3 y3
+        const Lanes dx = __builtin_shufflevector(a, b, 0, 2, 4, 6) - own_x[0];
+        Lanes dy = __builtin_shufflevector(a, b, 1, 3, 5, 7) - own_x[1];
+        if (periodic) dy = nearest_image(dy);
+        distance_squared = dx * dx + dy * dy;
+      } else {
+        Lanes q0;
+        Lanes q1;
+        Lanes q2;
+        const double* p = position[k].c.data();
+        std::memcpy(&q0, p, sizeof q0);                                  // x0 y0 z0 x1
+        std::memcpy(&q1, p + 4, sizeof q1);                              // y1 z1 x2 y2
+        std::memcpy(&q2, p + 8, sizeof q2);                              // z2 x3 y3 z3
+        const Lanes xy01 = __builtin_shufflevector(q0, q1, 0, 3, 6, 1);  // x0 x1 x2 y0
+        const Lanes yz01 = __builtin_shufflevector(q0, q1, 1, 4, 7, 2);  // y0 y1 y2 z0
+        const Lanes zs01 = __builtin_shufflevector(q0, q1, 2, 5, 0, 0);  // z0 z1 . .
+        const Lanes dx = __builtin_shufflevector(xy01, q2, 0, 1, 2, 5) - own_x[0];
+        const Lanes dy = __builtin_shufflevector(yz01, q2, 0, 1, 2, 6) - own_x[1];
+        Lanes dz = __builtin_shufflevector(zs01, q2, 0, 1, 4, 7) - own_x[2];
+        if (periodic) dz = nearest_image(dz);
+        distance_squared = (dx * dx + dy * dy) + dz * dz;
+      }
+      const Lanes reach = own_r + other_radius + skin_l;
+      const FourIndices lane = FourIndices{k, k, k, k} + FourIndices{0, 1, 2, 3};
+      const unsigned near = mask_bits(distance_squared < reach * reach);
+      const unsigned smaller = mask_bits(other_radius < own_r);
+      const unsigned same = mask_bits(other_radius == own_r);
+      const unsigned later = mask_bits(lane > own_slot);
+      const unsigned in_row = mask_bits(lane < row_end);
+      const unsigned keep = near & (smaller | (same & later)) & in_row;
+      FourIndices other;
+      std::memcpy(&other, member + k, sizeof other);
+      const FourIndices lower = other < own_index ? other : own_index;
+      const FourIndices higher = other < own_index ? own_index : other;
+      const EightIndices pairs = __builtin_shufflevector(lower, higher, 0, 4, 1, 5, 2, 6, 3, 7);
+      EightInts order;
+      std::memcpy(&order, kept_pair_words[keep].data(), sizeof order);
+      const auto packed = __builtin_ia32_permvarsi256(reinterpret_cast<EightInts>(pairs), order);
+      std::memcpy(found + 2 * n, &packed, sizeof packed);
+      n += static_cast<std::size_t>(__builtin_popcount(keep));
     }
-    const Lanes reach = own_r + other_radius + skin_l;
-    const FourIndices lane = FourIndices{k, k, k, k} + FourIndices{0, 1, 2, 3};
-    const unsigned near = mask_bits(distance_squared < reach * reach);
-    const unsigned smaller = mask_bits(other_radius < own_r);
-    const unsigned same = mask_bits(other_radius == own_r);
-    const unsigned later = mask_bits(lane > own_slot);
-    const unsigned in_row = mask_bits(lane < row_end);
-    const unsigned keep = near & (smaller | (same & later)) & in_row;
-    FourIndices other;
-    std::memcpy(&other, member + k, sizeof other);
-    const FourIndices lower = other < own_index ? other : own_index;
-    const FourIndices higher = other < own_index ? own_index : other;
-    const EightIndices pairs = __builtin_shufflevector(lower, higher, 0, 4, 1, 5, 2, 6, 3, 7);
-    EightInts order;
-    std::memcpy(&order, kept_pair_words[keep].data(), sizeof order);
-    const auto packed = __builtin_ia32_permvarsi256(reinterpret_cast<EightInts>(pairs), order);
-    std::memcpy(found + 2 * n, &packed, sizeof packed);
-    n += static_cast<std::size_t>(__builtin_popcount(keep));
   }
   return n;
 }
@@ -323,6 +340,22 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
         from[a] = cell_of(own_position[a] - reach_a, a);
         to[a] = cell_of(own_position[a] + reach_a, a);
       }
+#if defined(__x86_64__)
+      // With lanes, the rows are gathered and searched together (search_rows_avx2).
+      std::array<SlotRange, rows_at_once> rows;
+      std::size_t row_count = 0;
+      std::size_t candidates = 0;
+      const auto search_rows = [&] {
+        // Room for the rows' candidates and three more (search_rows_avx2).
+        const std::size_t room = n + candidates + lane_padding;
+        if (found.size() < room) found.resize(std::max(2 * found.size(), room));
+        n += search_rows_avx2<D>(own_position, own_radius, i, static_cast<std::uint32_t>(slot),
+                                 skin_, period_, cell_position_.data(), cell_radius_.data(),
+                                 cell_members_.data(), rows.data(), row_count, &found[n].first);
+        row_count = 0;
+        candidates = 0;
+      };
+#endif
       // Cells along axis 0 are contiguous in the cell order, so each row of the range is one
       // run of cell_members_ (axis 0 is never periodic).
       const auto visit_row = [&](std::size_t row) {
@@ -330,17 +363,16 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
             std::max(first_slot, cell_start_[row + static_cast<std::size_t>(from[0])]);
         const std::uint32_t end = cell_start_[row + static_cast<std::size_t>(to[0]) + 1];
         if (end <= begin) return;
-        // Room for the row rounded up to four (search_row_avx2).
-        const std::size_t room = n + (end - begin) + lane_padding;
-        if (found.size() < room) found.resize(std::max(2 * found.size(), room));
 #if defined(__x86_64__)
         if (lanes) {
-          n += search_row_avx2<D>(own_position, own_radius, i, static_cast<std::uint32_t>(slot),
-                                  skin_, period_, cell_position_.data(), cell_radius_.data(),
-                                  cell_members_.data(), begin, end, &found[n].first);
+          rows[row_count++] = {begin, end};
+          candidates += end - begin;
+          if (row_count == rows_at_once) search_rows();
           return;
         }
 #endif
+        const std::size_t room = n + (end - begin);
+        if (found.size() < room) found.resize(std::max(2 * found.size(), room));
         // Without a branch: every partner is written and kept only if it is found, as which
         // partners are (a third of those looked at in the 2D SAG scene) cannot be predicted,
         // nor, in a charge of several sizes, which of the two is the larger (`|` and `&`, not
@@ -378,6 +410,9 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
           }
         }
       }
+#if defined(__x86_64__)
+      if (row_count > 0) search_rows();
+#endif
     };
     // Particles in cell order, so that neighbouring searches touch neighbouring memory, in
     // chunks of a fixed size that threads search apart, each into its own list. The sorts
