@@ -1040,6 +1040,24 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
     // each pair (a loop of four the compiler unrolls, each lane's values taken from its
     // registers).
     const bool all_touch = filled == lanes && all(overlaps);
+    // touches(l) for each lane that touches; a lane that ended is recorded, marked apart and
+    // handed to ended(l).
+    const auto apply_outcomes = [&](auto&& touches, auto&& ended_lane)
+        __attribute__((always_inline)) {
+      if (all_touch) {
+        for (std::size_t l = 0; l < lanes; ++l) touches(l);
+        return;
+      }
+      for (std::size_t l = 0; l < filled; ++l) {
+        if (overlaps[l] == 0) {
+          record_pair_end(q[l], history[q[l]].dissipated, begin, ended, each_apart);
+          ended_lane(l);
+          touching[q[l]] = TouchState::apart;
+          continue;
+        }
+        touches(l);
+      }
+    };
     if constexpr (D == 2) {
       // The histories of the four lanes, written without a branch after the ended pairs'
       // energies are read: those of ended pairs zeroed, the rest the law's (a lane that repeats
@@ -1056,18 +1074,8 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
         particles_.torque[j[l]] += r[j[l]] * moment[l];
         record_pair_touch(q[l], out.dissipated[l], dissipated, each_apart);
       };
-      if (all_touch) {
-        for (std::size_t l = 0; l < lanes; ++l) touches(l);
-      } else {
-        for (std::size_t l = 0; l < filled; ++l) {
-          if (overlaps[l] == 0) {
-            record_pair_end(q[l], history[q[l]].dissipated, begin, ended, each_apart);
-            touching[q[l]] = TouchState::apart;
-            continue;
-          }
-          touches(l);
-        }
-      }
+      // (An ended lane's history is zeroed with the others' below.)
+      apply_outcomes(touches, [](std::size_t) __attribute__((always_inline)){});
       const T origin = select(overlaps, held.normal_spring_origin, zero);
       const T spring = select(overlaps, held.tangential_spring, zero);
       const T energy = select(overlaps, held.dissipated, zero);
@@ -1095,19 +1103,9 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
         particles_.torque[j[l]] += r[j[l]] * turn;
         record_pair_touch(pair, out.dissipated[l], dissipated, each_apart);
       };
-      if (all_touch) {
-        for (std::size_t l = 0; l < lanes; ++l) touches(l);
-      } else {
-        for (std::size_t l = 0; l < filled; ++l) {
-          if (overlaps[l] == 0) {
-            record_pair_end(q[l], history[q[l]].dissipated, begin, ended, each_apart);
-            history[q[l]] = ContactHistory<D>{};
-            touching[q[l]] = TouchState::apart;
-            continue;
-          }
-          touches(l);
-        }
-      }
+      apply_outcomes(
+          touches, [&](std::size_t l)
+                       __attribute__((always_inline)) { history[q[l]] = ContactHistory<D>{}; });
     }
   }
   dissipated_sum = dissipated;
