@@ -261,6 +261,32 @@ TEST_F(Cli, InfoOfAConicalMillPrintsItsCones) {
   EXPECT_NE(info.out.find("particles             385"), std::string::npos) << info.out;
 }
 
+TEST_F(Cli, InfoTakesEveryShippedConfig) {
+  // Every config a user is pointed to (examples/, bench/) is read and checked as `run` would
+  // read it, so that none drifts from the config format unnoticed; the mills' charges are
+  // placed (up to 200 000 particles) and the scenes' time steps worked out.
+  std::vector<std::filesystem::path> configs;
+  for (const char* folder : {"examples", "bench"}) {
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(
+             std::filesystem::path(MILLSIM_SOURCE_DIR) / folder)) {
+      if (entry.is_regular_file() && entry.path().extension() == ".toml") {
+        configs.push_back(entry.path());
+      }
+    }
+  }
+  std::sort(configs.begin(), configs.end());
+  ASSERT_GE(configs.size(), 20U);  // 26 when written: the folders were found and walked
+  for (const auto& config : configs) {
+    SCOPED_TRACE(config.string());
+    const Outcome info = millsim("info " + quoted(config.string()));
+    EXPECT_EQ(info.status, 0) << info.err;
+    EXPECT_EQ(info.err, "");
+    EXPECT_NE(info.out.find("config                " + config.string()), std::string::npos)
+        << info.out;
+    EXPECT_NE(info.out.find("time step"), std::string::npos) << info.out;
+  }
+}
+
 TEST_F(Cli, RefusesAFillingTheMillCannotHoldBothInRunAndInInfo) {
   // J = 0.9 plans 226 discs (2D void fraction 0.2), more than fit between the lifters: the
   // placement gives up, and `info`, which places the charge too, says so before printing.
