@@ -392,7 +392,8 @@ void World<D>::reorder_particles(const std::vector<std::uint32_t>& previous) {
   reorder(particle_id_, previous, 1, std::get<std::vector<std::uint32_t>>(reorder_scratch_));
   // This step's velocity estimates, made before the rebuild.
   reorder(velocity_now_, previous, 1, std::get<std::vector<Vec<D>>>(reorder_scratch_));
-  reorder(spin_now_, previous, 1, std::get<std::vector<Spin<D>>>(reorder_scratch_));
+  reorder(rim_speed_now_, previous, 1, std::get<std::vector<Spin<D>>>(reorder_scratch_));
+  reorder(rim_speed_step_, previous, 1, std::get<std::vector<Spin<D>>>(reorder_scratch_));
   reorder(wall_slots_of_, previous, 1, std::get<std::vector<std::uint32_t>>(reorder_scratch_));
   for (std::size_t k = 0; k < particle_id_.size(); ++k) {
     particle_index_[particle_id_[k]] = static_cast<std::uint32_t>(k);
@@ -476,7 +477,8 @@ template <int D>
 bool World<D>::estimate_current_velocities() {
   const std::size_t count = particles_.size();
   velocity_now_.resize(count);
-  spin_now_.resize(count);
+  rim_speed_now_.resize(count);
+  rim_speed_step_.resize(count);
   const double half_step = 0.5 * settings_.time_step;
   const auto& p = particles_;
   // Particles added since the last list: it must be made again.
@@ -484,8 +486,9 @@ bool World<D>::estimate_current_velocities() {
   const bool moved = for_each_particle_run([&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       velocity_now_[i] = estimate_now(p.velocity[i], p.inverse_mass[i], p.force[i], half_step);
-      spin_now_[i] =
-          estimate_now(p.angular_velocity[i], p.inverse_inertia[i], p.torque[i], half_step);
+      rim_speed_now_[i] = p.radius[i] * estimate_now(p.angular_velocity[i], p.inverse_inertia[i],
+                                                     p.torque[i], half_step);
+      rim_speed_step_[i] = p.radius[i] * p.angular_velocity[i];
     }
     return !added && neighbours_.moved_too_far(p.position, begin, end);
   });
@@ -501,7 +504,8 @@ void World<D>::check_estimates_made() const {
     const Vec<D> velocity = estimate_now(p.velocity[i], p.inverse_mass[i], p.force[i], half_step);
     const Spin<D> spin =
         estimate_now(p.angular_velocity[i], p.inverse_inertia[i], p.torque[i], half_step);
-    if (!(velocity == velocity_now_[i]) || !(spin == spin_now_[i]) ||
+    if (!(velocity == velocity_now_[i]) || !(p.radius[i] * spin == rim_speed_now_[i]) ||
+        !(p.radius[i] * p.angular_velocity[i] == rim_speed_step_[i]) ||
         (neighbours_.moved_too_far(i, p.position[i]) && !moved_half_skin_)) {
       std::fprintf(stderr,
                    "millsim: World::step: particle %zu was changed after the last step through a "
@@ -641,10 +645,9 @@ template <int D>
 typename World<D>::PairOutcome World<D>::evaluate_pair(std::size_t q, PairForce& out) {
   const auto& x = particles_.position;
   const auto& v = velocity_now_;
-  const auto& w = spin_now_;
+  const auto& rim = rim_speed_now_;
   const auto& step_v = particles_.velocity;
-  const auto& step_w = particles_.angular_velocity;
-  const auto& r = particles_.radius;
+  const auto& step_rim = rim_speed_step_;
   const auto& m = particles_.mass;
   auto& history = neighbours_.history();
   auto& touching = neighbours_.touching();
@@ -665,9 +668,9 @@ typename World<D>::PairOutcome World<D>::evaluate_pair(std::size_t q, PairForce&
   in.normal = offset * (1.0 / distance);
   in.overlap = reach - distance;
   in.velocity = v[j] - v[i];
-  in.spin_velocity = spin_sliding(in.normal, r[i] * w[i] + r[j] * w[j]);
+  in.spin_velocity = spin_sliding(in.normal, rim[i] + rim[j]);
   in.step_velocity = step_v[j] - step_v[i];
-  in.step_spin_velocity = spin_sliding(in.normal, r[i] * step_w[i] + r[j] * step_w[j]);
+  in.step_spin_velocity = spin_sliding(in.normal, step_rim[i] + step_rim[j]);
   touching[q] = TouchState::touching;
   // The dashpots' coefficients from the pair's effective mass, worked out here rather than
   // read from a per-pair array made at each rebuild, whose entries, read only for the few
@@ -916,9 +919,9 @@ void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, st
     prefetch_record(neighbours_.history()[q]);
     for (const std::uint32_t i : {neighbours_.first()[q], neighbours_.second()[q]}) {
       __builtin_prefetch(&velocity_now_[i]);
-      __builtin_prefetch(&spin_now_[i]);
+      __builtin_prefetch(&rim_speed_now_[i]);
       __builtin_prefetch(&p.velocity[i]);
-      __builtin_prefetch(&p.angular_velocity[i]);
+      __builtin_prefetch(&rim_speed_step_[i]);
       if (!uniform_mass_) __builtin_prefetch(&p.mass[i]);
       __builtin_prefetch(&p.force[i], 1);
       __builtin_prefetch(&p.torque[i], 1);
@@ -941,7 +944,8 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
   // positions, and over the last step.
   const auto& p = particles_;
   const auto& v = velocity_now_;
-  const auto& w = spin_now_;
+  const auto& rim = rim_speed_now_;
+  const auto& step_rim = rim_speed_step_;
   const auto& r = particles_.radius;
   auto& history = neighbours_.history();
   auto& touching = neighbours_.touching();
@@ -1008,12 +1012,10 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
     in.step_velocity = step_velocity;
     // The spins' sliding velocity from r_i ω_i + r_j ω_j, at the time of the positions and over
     // the last step.
-    in.spin_velocity = spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
-                                      return r[i[l]] * w[i[l]] + r[j[l]] * w[j[l]];
-                                    }));
+    in.spin_velocity = spin_sliding(
+        in.normal, gather_spin_lanes<D>([&](std::size_t l) { return rim[i[l]] + rim[j[l]]; }));
     in.step_spin_velocity = spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
-                                           return r[i[l]] * p.angular_velocity[i[l]] +
-                                                  r[j[l]] * p.angular_velocity[j[l]];
+                                           return step_rim[i[l]] + step_rim[j[l]];
                                          }));
 
     ContactHistory<D, T> held;
@@ -1335,12 +1337,11 @@ void World<D>::evaluate_wall_laws_in_lanes(const WallContact<D>* contact, WallWo
     const T radius = gather_lanes([&](std::size_t l) { return p.radius[particle(l)]; });
     // The spin's sliding velocity from r ω, at the time of the positions and over the last step.
     in.spin_velocity = spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
-                                      return p.radius[particle(l)] * spin_now_[particle(l)];
+                                      return rim_speed_now_[particle(l)];
                                     }));
-    in.step_spin_velocity =
-        spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
-                       return p.radius[particle(l)] * p.angular_velocity[particle(l)];
-                     }));
+    in.step_spin_velocity = spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
+                                           return rim_speed_step_[particle(l)];
+                                         }));
     // The dashpots' coefficients from the particle's mass (m* = m against a wall), as the pair
     // kernel has them (the same for every particle of a charge of one size).
     ContactDampingOf<T> damping;
@@ -1754,6 +1755,10 @@ struct FourVectors {
   return {{a.part[0] + s.part[0] * b.part[0], a.part[1] + s.part[1] * b.part[1],
            a.part[2] + s.part[2] * b.part[2]}};
 }
+/// s a, component by component, s spread as above.
+[[gnu::always_inline]] inline FourVectors times(const FourVectors& s, const FourVectors& a) {
+  return {{s.part[0] * a.part[0], s.part[1] * a.part[1], s.part[2] * a.part[2]}};
+}
 
 }  // namespace
 
@@ -1776,7 +1781,9 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
     const double* const inverse_mass = p.inverse_mass.data();
     const double* const inverse_inertia = p.inverse_inertia.data();
     Vec3* const velocity_now = velocity_now_.data();
-    Vec3* const spin_now = spin_now_.data();
+    const double* const radius = p.radius.data();
+    Vec3* const rim_now = rim_speed_now_.data();
+    Vec3* const rim_step = rim_speed_step_.data();
     const Vec3* const reference = neighbours_.reference_position().data();
     const Lanes limit = splat<Lanes>(neighbours_.half_skin_squared());
     const Vec3 g = settings_.gravity;
@@ -1808,13 +1815,15 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
           __builtin_prefetch(&velocity[a], 1);
           __builtin_prefetch(&spin[a], 1);
           __builtin_prefetch(&velocity_now[a], 1);
-          __builtin_prefetch(&spin_now[a], 1);
+          __builtin_prefetch(&rim_now[a], 1);
+          __builtin_prefetch(&rim_step[a], 1);
         }
         const std::size_t a = std::min(i + prefetch_distance, last);
         __builtin_prefetch(&inverse_mass[a]);
         __builtin_prefetch(&inverse_inertia[a]);
       }
       const Lanes m = load_four(&mass[i]);
+      const FourVectors r = spread(load_four(&radius[i]));
       const Lanes im = load_four(&inverse_mass[i]);
       const Lanes ii = load_four(&inverse_inertia[i]);
       FourVectors f = load_vectors(&force[i]);
@@ -1836,14 +1845,15 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
       store_vectors(&position[i], x);
       const FourVectors w = add_scaled(load_vectors(&spin[i]), spread(ii * dt), t);
       store_vectors(&spin[i], w);
+      store_vectors(&rim_step[i], times(r, w));
       // The estimates, as estimate_now makes them.
       store_vectors(&velocity_now[i], add_scaled(v, spread(half_step * im), f));
-      store_vectors(&spin_now[i], add_scaled(w, spread(half_step * ii), t));
+      store_vectors(&rim_now[i], times(r, add_scaled(w, spread(half_step * ii), t)));
       // Moved half a skin: each sphere's (dx² + dy²) + dz², as norm_squared sums them.
-      const FourVectors r = load_vectors(&reference[i]);
-      const Lanes d0 = x.part[0] - r.part[0];
-      const Lanes d1 = x.part[1] - r.part[1];
-      const Lanes d2 = x.part[2] - r.part[2];
+      const FourVectors x0 = load_vectors(&reference[i]);
+      const Lanes d0 = x.part[0] - x0.part[0];
+      const Lanes d1 = x.part[1] - x0.part[1];
+      const Lanes d2 = x.part[2] - x0.part[2];
       if (periodic && any((axial[0] & (lane_abs(d0) >= crossed_lanes)) |
                           (axial[1] & (lane_abs(d1) >= crossed_lanes)) |
                           (axial[2] & (lane_abs(d2) >= crossed_lanes)))) {
@@ -1892,7 +1902,9 @@ bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
   const double* const inverse_mass = p.inverse_mass.data();
   const double* const inverse_inertia = p.inverse_inertia.data();
   Vec<D>* const velocity_now = velocity_now_.data();
-  Spin<D>* const spin_now = spin_now_.data();
+  const double* const radius = p.radius.data();
+  Spin<D>* const rim_now = rim_speed_now_.data();
+  Spin<D>* const rim_step = rim_speed_step_.data();
   const Vec<D>* const reference = neighbours_.reference_position().data();
   const double limit = neighbours_.half_skin_squared();
   const Vec<D> gravity = settings_.gravity;
@@ -1922,7 +1934,8 @@ bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
       __builtin_prefetch(&velocity[ahead], 1);
       __builtin_prefetch(&spin[ahead], 1);
       __builtin_prefetch(&velocity_now[ahead], 1);
-      __builtin_prefetch(&spin_now[ahead], 1);
+      __builtin_prefetch(&rim_now[ahead], 1);
+      __builtin_prefetch(&rim_step[ahead], 1);
     }
     force[i] += mass[i] * gravity;
     velocity[i] += (inverse_mass[i] * dt) * force[i];
@@ -1937,7 +1950,8 @@ bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
     const Vec<D> offset =
         periodic ? neighbours_.displacement(reference[i], position[i]) : position[i] - reference[i];
     velocity_now[i] = estimate_now(velocity[i], inverse_mass[i], force[i], half_step);
-    spin_now[i] = estimate_now(spin[i], inverse_inertia[i], torque[i], half_step);
+    rim_step[i] = radius[i] * spin[i];
+    rim_now[i] = radius[i] * estimate_now(spin[i], inverse_inertia[i], torque[i], half_step);
     moved |= norm_squared(offset) > limit ? 1U : 0U;
   }
   return moved != 0;
