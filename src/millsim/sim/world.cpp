@@ -1924,10 +1924,10 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
       store_vectors(&velocity_now[i], add_scaled(v, spread(half_step * im), f));
       store_vectors(&rim_now[i], times(r, add_scaled(w, spread(half_step * ii), t)));
       // Moved half a skin: each sphere's (dx² + dy²) + dz², as norm_squared sums them.
-      const FourVectors x0 = load_vectors(&reference[i]);
-      const Lanes d0 = x.part[0] - x0.part[0];
-      const Lanes d1 = x.part[1] - x0.part[1];
-      const Lanes d2 = x.part[2] - x0.part[2];
+      const FourVectors at_rebuild = load_vectors(&reference[i]);
+      const Lanes d0 = x.part[0] - at_rebuild.part[0];
+      const Lanes d1 = x.part[1] - at_rebuild.part[1];
+      const Lanes d2 = x.part[2] - at_rebuild.part[2];
       if (periodic && any((axial[0] & (lane_abs(d0) >= crossed_lanes)) |
                           (axial[1] & (lane_abs(d1) >= crossed_lanes)) |
                           (axial[2] & (lane_abs(d2) >= crossed_lanes)))) {
