@@ -1,8 +1,8 @@
 // Deterministic by construction (STYLE.md rule 5): the same scene stepped on one thread, on
 // two and on three gives bitwise-identical particles, energy accounts and collision spectra. The
 // stages of World::step() go parallel only above 2048 items (particles, wall candidates,
-// listed pairs; `parallel_threshold` in sim/world.cpp), so the scenes are big enough for every
-// parallel path to run, and the test checks that they are. The particles are renumbered in
+// listed pairs; `parallel_threshold` in sim/world_detail.hpp), so the scenes are big enough for
+// every parallel path to run, and the test checks that they are. The particles are renumbered in
 // cell order at every neighbour-list rebuild (the mill job does it less often), during the
 // compared steps too, and come out in the same order on one thread and on two.
 #include <fmt/format.h>
@@ -26,7 +26,7 @@ namespace millsim {
 namespace {
 
 /// The item count above which a stage of World::step() runs in parallel, and the listed pairs
-/// from which the pair stage does (sim/world.cpp).
+/// from which the pair stage does (sim/world_detail.hpp).
 constexpr std::size_t parallel_threshold = 2048;
 constexpr std::size_t parallel_pair_threshold = 2048;
 

@@ -356,13 +356,10 @@ class World {
   /// Whether the pair stage runs on several threads; if so, makes sure its split of particles
   /// and pairs among them (split_pairs_among) is that of the current list and thread count.
   bool pairs_split_among_threads();
-  /// body(i) for every particle: on several threads each its own run of particles of the pair
-  /// stage (so that a thread's particles stay in its core's cache from stage to stage), else
-  /// on one thread, or split evenly if there are many particles but few pairs.
-  template <class Body>
-  void for_each_particle(Body&& body);
-  /// The same with body(begin, end) for runs of particles that together are all of them, once
-  /// each; returns whether any call returned true.
+  /// body(begin, end) for runs of particles that together are all of them, once each: on
+  /// several threads each its own run of particles of the pair stage (so that a thread's
+  /// particles stay in its core's cache from stage to stage), else on one thread, or split
+  /// evenly if there are many particles but few pairs. Returns whether any call returned true.
   template <class Body>
   bool for_each_particle_run(Body&& body);
   /// A wall slot's history, with the overlap its stored-energy account needs (a pair's is
@@ -544,7 +541,7 @@ class World {
   // Work is split in blocks of a fixed size; each block keeps its own sums and ended
   // collisions, added up in block order, so results do not depend on the number of threads.
   std::size_t pair_block_ = 1024;  // pairs per block, and candidates per wall block, chosen
-  std::size_t wall_block_ = 256;   // at each rebuild (block_size_for in world.cpp)
+  std::size_t wall_block_ = 256;   // at each rebuild (block_size_for in world_detail.hpp)
   std::vector<EndedCollision> pair_ended_;  // block b's at [b × pair_block_, ...)
   std::vector<std::uint32_t> pair_block_ended_;
   std::vector<double> pair_block_dissipated_;

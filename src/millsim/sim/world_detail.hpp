@@ -1,0 +1,83 @@
+// What World's stage files (world*.cpp) share: the sizes of the blocks of pairs and wall
+// candidates that are the unit of parallel work and of partial sums, and the thresholds that
+// decide when a stage runs on several threads. Internal to World; not part of the library's
+// interface.
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <cstddef>
+
+#include "millsim/geometry/walls.hpp"
+#include "millsim/measure/spectrum.hpp"
+
+namespace millsim::world_detail {
+
+inline ContactType wall_contact_type(WallKind kind) {
+  switch (kind) {
+    case WallKind::shell:
+      return ContactType::ball_shell;
+    case WallKind::lifter:
+      return ContactType::ball_lifter;
+    case WallKind::end_plate:
+      return ContactType::ball_end_plate;
+    case WallKind::plane:
+      return ContactType::ball_plane;
+  }
+  return ContactType::ball_plane;
+}
+
+/// Blocks of pairs and of wall candidates are the unit of parallel work and of partial sums.
+/// Their sizes are chosen at each rebuild from the list alone (block_size_for), never from
+/// the number of threads, so that results do not depend on it: a sixteenth of the pairs and a
+/// quarter of the candidates, rounded up to a power of two within 256–1024 pairs or 64–256
+/// candidates (so at most 16 and 4 blocks where the size is not at its largest). Large
+/// blocks cost less per pair (the 2D SAG scene, 941 candidates, was 0.7 % slower on two threads
+/// in 8 blocks of 128 than in 4 of 256); in a small world, where one block was a third of the
+/// list, the blocks that two threads' runs share (done one pair at a time, or by one thread for
+/// both) held up the step (bench/results.md).
+inline constexpr std::size_t min_pair_block = 256;
+inline constexpr std::size_t max_pair_block = 1024;
+inline constexpr std::size_t min_wall_block = 64;
+inline constexpr std::size_t max_wall_block = 256;
+/// Below this many items a stage runs on one thread (a parallel region costs microseconds).
+inline constexpr std::size_t parallel_threshold = 2048;
+/// The fewest wall candidates whose nearby lifters are found on several threads in a world
+/// whose step splits among them.
+inline constexpr std::size_t parallel_candidate_threshold_when_split = 256;
+/// The pair stage, and with it the particle stages, split among threads from this many listed
+/// pairs, where two threads and one break even: below it the threads' barriers cost more than
+/// the split saves (the 3D scaling slab of 996 balls and 2 500 pairs on two threads against
+/// one: 1.1 times faster on an Intel host, 0.85 times on an AMD one, which broke even at about
+/// 5 000 pairs; bench/results.md).
+inline constexpr std::size_t parallel_pair_threshold = 2048;
+/// The same for the old three-stage path's wall stage, whose candidates cost tens of pairs
+/// each: from 512 on (the 2D SAG scene has about a thousand candidates; on one thread they held
+/// the other one waiting for 3 % of the step).
+inline constexpr std::size_t parallel_wall_threshold = 2 * max_wall_block;
+
+/// The block size for a list of `items`: items / blocks rounded up to a power of two, within
+/// [smallest, largest].
+inline std::size_t block_size_for(std::size_t items, std::size_t blocks, std::size_t smallest,
+                                  std::size_t largest) {
+  return std::clamp(std::bit_ceil(std::max<std::size_t>(1, items / blocks)), smallest, largest);
+}
+
+/// Whether a list of `pairs` splits the step among `threads` threads.
+inline bool splits_among_threads(std::size_t pairs, int threads) {
+  return threads > 1 && pairs >= parallel_pair_threshold;
+}
+/// When the particle arrays that the pair kernel reads and writes hold more than this many
+/// bytes, half a core's second-level cache here, the kernel prefetches the particles and
+/// history of the pairs two lanes ahead: the second particle of a pair is met out of order and
+/// comes from beyond that cache otherwise. Below it the prefetches cost more than they save
+/// (bench/results.md, sixteenth session: the 2D SAG scene, 0.6 MB, 5–7 % slower with them; the
+/// 1e4-ball slab, 1.5 MB, 2–4 % faster; the 3D 20 k scene and the LIGGGHTS comparison's, 3 MB,
+/// 3–8 % faster; the 1e5-ball slab, 15 MB, +10 % in the eleventh).
+inline constexpr std::size_t prefetch_threshold_bytes = std::size_t{1} << 20;
+
+inline std::size_t block_count(std::size_t items, std::size_t block) {
+  return (items + block - 1) / block;
+}
+
+}  // namespace millsim::world_detail
