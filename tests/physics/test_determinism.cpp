@@ -21,14 +21,16 @@
 #include "millsim/particles/material.hpp"
 #include "millsim/sim/charge.hpp"
 #include "millsim/sim/world.hpp"
+#include "millsim/sim/world_detail.hpp"
 
 namespace millsim {
 namespace {
 
 /// The item count above which a stage of World::step() runs in parallel, and the listed pairs
-/// from which the pair stage does (sim/world_detail.hpp).
-constexpr std::size_t parallel_threshold = 2048;
-constexpr std::size_t parallel_pair_threshold = 2048;
+/// from which the pair stage does: the World's own (read from its header, so that the scenes
+/// below follow them if they change).
+using world_detail::parallel_pair_threshold;
+using world_detail::parallel_threshold;
 
 /// Sets the OpenMP thread count for the life of the object, then puts the old one back.
 class ThreadCount {
