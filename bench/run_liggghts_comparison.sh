@@ -3,7 +3,7 @@
 # (bench/mill-3d-20k.toml: 0.9 m x 0.73 m, eight 4 x 4 cm lifters, flat end plates, 19 956
 # balls of 20 mm, 30 % filling, 75 % of critical, dt 1e-5 s, the same k_n, k_s, e, mu).
 #
-#   bench/run_liggghts_comparison.sh [STEPS]                 speed (about 10 min, idle machine)
+#   bench/run_liggghts_comparison.sh [STEPS [ROUNDS]]        speed (about 40 s a round)
 #   bench/run_liggghts_comparison.sh --power [LIFT [WINDOW]]   power drawn (about 10 min)
 #
 # Both: install LIGGGHTS with apt-get if `liggghts` is missing (needs root), build millsim,
@@ -16,8 +16,10 @@
 #
 # Speed: the shell turns at full speed for 1000 untimed steps, then STEPS (default 5000) steps
 # are timed: millsim on 1 thread, LIGGGHTS on 1 MPI rank, millsim on 2 threads, LIGGGHTS on 2
-# ranks, back to back. Prints particle-steps/s (LIGGGHTS: atoms x steps / loop time of the
-# timed `run`) and the ratio millsim/LIGGGHTS.
+# ranks, back to back; ROUNDS times (default 3), so that each ratio is of two runs minutes
+# apart at most, and a shared machine's slow minute shows as one round out of line. Prints
+# particle-steps/s (LIGGGHTS: atoms x steps / loop time of the timed `run`) and the ratio
+# millsim/LIGGGHTS of each round, then each code's median rate and the median of the ratios.
 #
 # Power (not timed, so the two codes run at the same time, each on one core; millsim's result
 # does not depend on its thread count): from the settled state the shell turns at full speed at
@@ -41,12 +43,18 @@ numbers=()
 for arg in "$@"; do
   case "$arg" in
     --power) mode=power ;;
-    ''|*[!0-9]*) echo "usage: $0 [STEPS] | $0 --power [LIFT [WINDOW]]" >&2; exit 2 ;;
+    ''|*[!0-9]*) echo "usage: $0 [STEPS [ROUNDS]] | $0 --power [LIFT [WINDOW]]" >&2; exit 2 ;;
     *) numbers+=("$arg") ;;
   esac
 done
+rounds=3
 if [ "$mode" = speed ]; then
   steps=${numbers[0]:-$steps}
+  rounds=${numbers[1]:-$rounds}
+  if [ "$steps" -eq 0 ] || [ "$rounds" -eq 0 ]; then
+    echo "usage: $0 [STEPS [ROUNDS]]: both at least 1" >&2
+    exit 2
+  fi
 else
   lift=${numbers[0]:-$lift}
   window=${numbers[1]:-$window}
@@ -104,24 +112,37 @@ if [ "$mode" = speed ]; then
   python3 bench/liggghts/make_input.py "$config" "$state" "$work/timing" \
     --mode timing --warmup $warmup --steps "$steps"
   declare -A ms lg
-  for n in 1 2; do
-    echo "== millsim, $n thread(s): $warmup warmup + $steps timed steps"
-    "$bench" "$config" --load-state "$state" --warmup $warmup --steps "$steps" -j $n \
-      | tee "$work/millsim-$n.txt" | grep -E '^(timed|particle-steps)'
-    ms[$n]=$(rate_of_millsim "$work/millsim-$n.txt")
-    echo "== LIGGGHTS, $n MPI rank(s): $warmup warmup + $steps timed steps"
-    (cd "$work/timing" && mpirun --allow-run-as-root --bind-to none -np $n liggghts \
-      -in in.mill -log "log.np$n" > "screen.np$n")
-    grep '^Loop time of' "$work/timing/log.np$n" | tail -1
-    lg[$n]=$(rate_of_liggghts "$work/timing/log.np$n")
+  for round in $(seq 1 "$rounds"); do
+    for n in 1 2; do
+      echo "== round $round of $rounds: millsim, $n thread(s): $warmup warmup + $steps timed steps"
+      "$bench" "$config" --load-state "$state" --warmup $warmup --steps "$steps" -j $n \
+        | tee "$work/millsim-$n-$round.txt" | grep -E '^(timed|particle-steps)'
+      ms[$n,$round]=$(rate_of_millsim "$work/millsim-$n-$round.txt")
+      echo "== round $round of $rounds: LIGGGHTS, $n MPI rank(s): $warmup warmup + $steps timed steps"
+      (cd "$work/timing" && mpirun --allow-run-as-root --bind-to none -np $n liggghts \
+        -in in.mill -log "log.np$n.$round" > "screen.np$n.$round")
+      grep '^Loop time of' "$work/timing/log.np$n.$round" | tail -1
+      lg[$n,$round]=$(rate_of_liggghts "$work/timing/log.np$n.$round")
+    done
   done
+  # The middle value (the mean of the two middle ones for an even count).
+  median() { printf '%s\n' "$@" | sort -g | awk '{v[NR] = $1} END {
+    printf "%.4g\n", NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
   echo
   echo "== particle-steps per second ($steps timed steps after $warmup at full speed;" \
     "load average now $(cut -d' ' -f1-3 /proc/loadavg))"
-  printf '%-7s %14s %14s %18s\n' cores millsim LIGGGHTS millsim/LIGGGHTS
+  printf '%-7s %-7s %14s %14s %18s\n' cores round millsim LIGGGHTS millsim/LIGGGHTS
   for n in 1 2; do
-    printf '%-7s %14s %14s %18s\n' "$n" "${ms[$n]}" "${lg[$n]}" \
-      "$(awk -v a="${ms[$n]}" -v b="${lg[$n]}" 'BEGIN {printf "%.2f", a / b}')"
+    ratios=()
+    for round in $(seq 1 "$rounds"); do
+      ratio=$(awk -v a="${ms[$n,$round]}" -v b="${lg[$n,$round]}" 'BEGIN {printf "%.2f", a / b}')
+      ratios+=("$ratio")
+      printf '%-7s %-7s %14s %14s %18s\n' "$n" "$round" "${ms[$n,$round]}" "${lg[$n,$round]}" "$ratio"
+    done
+    mine=(); theirs=()
+    for round in $(seq 1 "$rounds"); do mine+=("${ms[$n,$round]}"); theirs+=("${lg[$n,$round]}"); done
+    printf '%-7s %-7s %14s %14s %18s\n' "$n" median "$(median "${mine[@]}")" \
+      "$(median "${theirs[@]}")" "$(median "${ratios[@]}")"
   done
   exit 0
 fi
