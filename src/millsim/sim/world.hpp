@@ -414,6 +414,25 @@ class World {
   bool accumulate_forces_and_integrate();
   /// Particles [begin, end) advanced by the loop for this world (integrate_particles).
   bool integrate_run(std::size_t begin, std::size_t end);
+  /// The arrays the integration reads and writes, by pointer, for its loops to hold in locals
+  /// (through the vectors the compiler could not tell that the loops' stores leave the vectors'
+  /// and the list's members unchanged). In the order the loops bind them.
+  struct IntegrationArrays {
+    Vec<D>* force;
+    const Spin<D>* torque;
+    Vec<D>* velocity;
+    Vec<D>* position;
+    Spin<D>* spin;
+    const double* mass;
+    const double* inverse_mass;
+    const double* inverse_inertia;
+    const double* radius;
+    Vec<D>* velocity_now;     ///< u̇(n+1) estimates (velocity_now_)
+    Spin<D>* rim_now;         ///< r ω(n+1) estimates (rim_speed_now_)
+    Spin<D>* rim_step;        ///< r ω(n+½) (rim_speed_step_)
+    const Vec<D>* reference;  ///< positions at the last rebuild
+  };
+  IntegrationArrays integration_arrays();
   /// Its loop over particles [begin, end), for a periodic slab or not. Processors with AVX2 run
   /// a second version, the same bits either way (integrate_particles_avx2): in 2D the loop
   /// without a period compiled again (two discs in a register, where the other works on one),

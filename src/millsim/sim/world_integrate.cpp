@@ -99,6 +99,24 @@ bool World<D>::accumulate_forces_and_integrate() {
 }
 
 template <int D>
+typename World<D>::IntegrationArrays World<D>::integration_arrays() {
+  auto& p = particles_;
+  return {.force = p.force.data(),
+          .torque = p.torque.data(),
+          .velocity = p.velocity.data(),
+          .position = p.position.data(),
+          .spin = p.angular_velocity.data(),
+          .mass = p.mass.data(),
+          .inverse_mass = p.inverse_mass.data(),
+          .inverse_inertia = p.inverse_inertia.data(),
+          .radius = p.radius.data(),
+          .velocity_now = velocity_now_.data(),
+          .rim_now = rim_speed_now_.data(),
+          .rim_step = rim_speed_step_.data(),
+          .reference = neighbours_.reference_position().data()};
+}
+
+template <int D>
 bool World<D>::integrate_run(std::size_t begin, std::size_t end) {
 #if defined(__x86_64__)
   if (avx2_lanes_) return integrate_particles_avx2(begin, end);
@@ -162,20 +180,8 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
     // operation is the one the scalar loop does on each component, so the bits are the same.
     // The compiler's own vectorisation of the scalar loop took the vectors apart into x and y
     // registers and back (about thirty instructions a disc).
-    auto& p = particles_;
-    Vec2* const force = p.force.data();
-    const double* const torque = p.torque.data();
-    Vec2* const velocity = p.velocity.data();
-    Vec2* const position = p.position.data();
-    double* const spin = p.angular_velocity.data();
-    const double* const mass = p.mass.data();
-    const double* const inverse_mass = p.inverse_mass.data();
-    const double* const inverse_inertia = p.inverse_inertia.data();
-    const double* const radius = p.radius.data();
-    Vec2* const velocity_now = velocity_now_.data();
-    double* const rim_now = rim_speed_now_.data();
-    double* const rim_step = rim_speed_step_.data();
-    const Vec2* const reference = neighbours_.reference_position().data();
+    const auto [force, torque, velocity, position, spin, mass, inverse_mass, inverse_inertia,
+                radius, velocity_now, rim_now, rim_step, reference] = integration_arrays();
     const Lanes limit = splat<Lanes>(neighbours_.half_skin_squared());
     const Vec2 g = settings_.gravity;
     const Lanes gravity{g[0], g[1], g[0], g[1]};
@@ -236,20 +242,8 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
     // operation the one the scalar loop does on each component (the per-sphere factors spread
     // over the components), so the bits are the same. The scalar loop, one sphere at a time
     // through SSE2 halves, was bound by its instructions (about ninety a sphere).
-    auto& p = particles_;
-    Vec3* const force = p.force.data();
-    const Vec3* const torque = p.torque.data();
-    Vec3* const velocity = p.velocity.data();
-    Vec3* const position = p.position.data();
-    Vec3* const spin = p.angular_velocity.data();
-    const double* const mass = p.mass.data();
-    const double* const inverse_mass = p.inverse_mass.data();
-    const double* const inverse_inertia = p.inverse_inertia.data();
-    Vec3* const velocity_now = velocity_now_.data();
-    const double* const radius = p.radius.data();
-    Vec3* const rim_now = rim_speed_now_.data();
-    Vec3* const rim_step = rim_speed_step_.data();
-    const Vec3* const reference = neighbours_.reference_position().data();
+    const auto [force, torque, velocity, position, spin, mass, inverse_mass, inverse_inertia,
+                radius, velocity_now, rim_now, rim_step, reference] = integration_arrays();
     const Lanes limit = splat<Lanes>(neighbours_.half_skin_squared());
     const Vec3 g = settings_.gravity;
     const FourVectors gravity{{Lanes{g[0], g[1], g[2], g[0]}, Lanes{g[1], g[2], g[0], g[1]},
@@ -267,7 +261,7 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
                                             Lanes{1.0, 0.0, 0.0, 1.0} > 0.0}};
     constexpr std::size_t prefetch_distance = 12;
     const bool prefetch = prefetch_pairs_;
-    const std::size_t last = p.size() - 1;
+    const std::size_t last = particles_.size() - 1;
     Mask<Lanes> moved{};
     bool moved_one_by_one = false;
     std::size_t i = begin;
@@ -357,20 +351,8 @@ template <bool periodic>
 bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
   // The arrays by pointer, and the constants in locals: the compiler cannot tell that the
   // stores below leave the vectors' and the list's members unchanged.
-  auto& p = particles_;
-  Vec<D>* const force = p.force.data();
-  const Spin<D>* const torque = p.torque.data();
-  Vec<D>* const velocity = p.velocity.data();
-  Vec<D>* const position = p.position.data();
-  Spin<D>* const spin = p.angular_velocity.data();
-  const double* const mass = p.mass.data();
-  const double* const inverse_mass = p.inverse_mass.data();
-  const double* const inverse_inertia = p.inverse_inertia.data();
-  Vec<D>* const velocity_now = velocity_now_.data();
-  const double* const radius = p.radius.data();
-  Spin<D>* const rim_now = rim_speed_now_.data();
-  Spin<D>* const rim_step = rim_speed_step_.data();
-  const Vec<D>* const reference = neighbours_.reference_position().data();
+  const auto [force, torque, velocity, position, spin, mass, inverse_mass, inverse_inertia, radius,
+              velocity_now, rim_now, rim_step, reference] = integration_arrays();
   const double limit = neighbours_.half_skin_squared();
   const Vec<D> gravity = settings_.gravity;
   const double dt = settings_.time_step;
@@ -385,7 +367,7 @@ bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
   // (A 2D world that large would take the plain loop too, at the cost of its second build.)
   constexpr std::size_t prefetch_distance = 12;
   const bool prefetch = D == 3 && prefetch_pairs_;
-  const std::size_t last = p.size() - 1;
+  const std::size_t last = particles_.size() - 1;
 #if !defined(__clang__)  // GCC's; `omp simd` left this loop unvectorised
 #pragma GCC ivdep
 #endif
@@ -430,6 +412,8 @@ template void World<2>::check_estimates_made() const;
 template void World<3>::check_estimates_made() const;
 template bool World<2>::accumulate_forces_and_integrate();
 template bool World<3>::accumulate_forces_and_integrate();
+template typename World<2>::IntegrationArrays World<2>::integration_arrays();
+template typename World<3>::IntegrationArrays World<3>::integration_arrays();
 template bool World<2>::integrate_run(std::size_t, std::size_t);
 template bool World<3>::integrate_run(std::size_t, std::size_t);
 #if defined(__x86_64__)
