@@ -88,6 +88,14 @@ template <class M>
   return r;
 }
 
+/// core/vec.hpp's nearest_integer in every lane, by the same operations.
+[[gnu::always_inline]] inline Lanes lane_nearest_integer(Lanes t) {
+  Lanes two_to_52;
+  for (int l = 0; l < lane_count; ++l) two_to_52[l] = 4503599627370496.0;
+  const Lanes magnitude = lane_abs(t);
+  return lane_copysign(magnitude < two_to_52 ? (magnitude + two_to_52) - two_to_52 : magnitude, t);
+}
+
 /// Lanes holding f(l) in lane l, for l = 0 … lane_count − 1 (f gives one double per lane).
 template <class F>
 [[gnu::always_inline]] inline Lanes gather_lanes(F&& f) {

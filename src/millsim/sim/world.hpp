@@ -324,8 +324,10 @@ class World {
   std::size_t list_pairs_of(std::size_t begin, std::size_t end, std::size_t below,
                             std::uint32_t* listed) const;
 #if defined(__x86_64__)
-  /// list_pairs_of<false, true> with AVX2, four pairs at a time: the same list.
+  /// list_pairs_of with AVX2, four pairs at a time: the same list.
+  template <bool periodic, bool every_pair>
   __attribute__((target("avx2"))) std::size_t list_pairs_avx2(std::size_t begin, std::size_t end,
+                                                              std::size_t below,
                                                               std::uint32_t* listed) const;
 #endif
   /// A listed pair's outcome: its collision ended with `energy`, or it touches and dissipated

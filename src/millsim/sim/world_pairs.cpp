@@ -78,18 +78,34 @@ std::size_t World<D>::list_pairs_for_law(std::size_t begin, std::size_t end, std
                                          std::uint32_t* listed) const {
   // Four loops, so that each pair costs only the instructions its world needs (the loop is
   // bound by their number: about 37 a pair, five a cycle, in the 3D 20 k scene before), and with
-  // AVX2 a fifth that takes four pairs at a time: in 3D worlds that are not periodic, and in 2D
+  // AVX2 two more that take four pairs at a time: in 3D worlds, periodic or not, and in 2D
   // worlds small enough for the caches (a larger one keeps the one-by-one loop, which fetches
   // the position of the pair 64 ahead's second particle; bench/results.md).
   const bool every_pair = below >= particles_.size();
+  const bool periodic = neighbours_.period() > 0.0;
   std::size_t count = 0;
-  if (neighbours_.period() > 0.0) {
+  bool in_lanes = false;
+#if defined(__x86_64__)
+  if (avx2_lanes_ && (D == 3 || !prefetch_pairs_)) {
+    if constexpr (D == 3) {  // (a 2D world is never periodic)
+      if (periodic) {
+        count = every_pair ? list_pairs_avx2<true, true>(begin, end, below, listed)
+                           : list_pairs_avx2<true, false>(begin, end, below, listed);
+        in_lanes = true;
+      }
+    }
+    if (!in_lanes) {
+      count = every_pair ? list_pairs_avx2<false, true>(begin, end, below, listed)
+                         : list_pairs_avx2<false, false>(begin, end, below, listed);
+      in_lanes = true;
+    }
+  }
+#endif
+  if (in_lanes) {
+    // Listed above.
+  } else if (periodic) {
     count = every_pair ? list_pairs_of<true, true>(begin, end, below, listed)
                        : list_pairs_of<true, false>(begin, end, below, listed);
-#if defined(__x86_64__)
-  } else if (every_pair && avx2_lanes_ && (D == 3 || !prefetch_pairs_)) {
-    count = list_pairs_avx2(begin, end, listed);
-#endif
   } else {
     count = every_pair ? list_pairs_of<false, true>(begin, end, below, listed)
                        : list_pairs_of<false, false>(begin, end, below, listed);
@@ -127,7 +143,8 @@ constexpr std::array<KeptLanes, 16> kept_lanes = kept_lanes_table();
 }  // namespace
 
 template <int D>
-std::size_t World<D>::list_pairs_avx2(std::size_t begin, std::size_t end,
+template <bool periodic, bool every_pair>
+std::size_t World<D>::list_pairs_avx2(std::size_t begin, std::size_t end, std::size_t below,
                                       std::uint32_t* listed) const {
   {
     constexpr auto lanes = static_cast<std::size_t>(lane_count);
@@ -138,13 +155,21 @@ std::size_t World<D>::list_pairs_avx2(std::size_t begin, std::size_t end,
     const TouchState* touching = neighbours_.touching().data();
     static_assert(static_cast<std::uint8_t>(TouchState::apart) == 0 &&
                   static_cast<std::uint8_t>(TouchState::touching) == 1);
+    [[maybe_unused]] const Lanes period = splat<Lanes>(neighbours_.period());
     std::size_t count = 0;
     std::size_t q = begin;
     for (; q + lanes <= end; q += lanes) {
       std::array<std::uint32_t, lanes> i{}, j{};
+      unsigned own = 0xFU;  // bit l: lane l's second particle is below `below`
       for (std::size_t l = 0; l < lanes; ++l) {
         i[l] = first[q + l];
         j[l] = second[q + l];
+        if constexpr (!every_pair) {
+          // As list_pairs_of: another thread's particle is not read, the first stands in.
+          const unsigned owned = j[l] < below ? 1U : 0U;
+          own &= ~((1U - owned) << l);
+          j[l] = owned != 0U ? j[l] : i[l];
+        }
       }
       // The operations of list_pairs_of, in the same order, each lane a pair.
       Lanes distance_squared{};
@@ -155,7 +180,12 @@ std::size_t World<D>::list_pairs_avx2(std::size_t begin, std::size_t end,
       } else {
         const Vec<2, Lanes> planar = lanes_of(
             [&](std::size_t l) { return planar_pair_of(x[j[l]]) - planar_pair_of(x[i[l]]); });
-        const Lanes dz = gather_lanes([&](std::size_t l) { return x[j[l]][2] - x[i[l]][2]; });
+        Lanes dz = gather_lanes([&](std::size_t l) { return x[j[l]][2] - x[i[l]][2]; });
+        if constexpr (periodic) {
+          // The nearest image along the axis, as NeighbourList::separation makes it:
+          // dz − period · nearest_integer(dz / period), each operation as core/vec.hpp's.
+          dz = dz - period * lane_nearest_integer(dz / period);
+        }
         distance_squared = (planar[0] * planar[0] + planar[1] * planar[1]) + dz * dz;
       }
       Lanes reach;
@@ -166,6 +196,7 @@ std::size_t World<D>::list_pairs_avx2(std::size_t begin, std::size_t end,
       std::uint32_t states = 0;
       std::memcpy(&states, touching + q, sizeof states);
       keep |= ((states * 0x01020408U) >> 24) & 0xFU;
+      keep &= own;
       // The kept pairs' numbers written at once, in order; the rest of the four is overwritten
       // by the next ones (or repeats, or is left beyond the count).
       FourIndices numbers{};
@@ -174,7 +205,7 @@ std::size_t World<D>::list_pairs_avx2(std::size_t begin, std::size_t end,
       std::memcpy(listed + count, &numbers, sizeof numbers);
       count += kept_lanes[keep].count;
     }
-    return count + list_pairs_of<false, true>(q, end, end, listed + count);
+    return count + list_pairs_of<periodic, every_pair>(q, end, below, listed + count);
   }
 }
 #endif
@@ -325,6 +356,7 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
   const double dt = settings_.time_step;
   const std::size_t begin = block * pair_block_;
   const bool periodic = neighbours_.period() > 0.0;
+  [[maybe_unused]] const T period = splat<T>(neighbours_.period());
 
   for (std::size_t k = 0; k < count; k += lanes) {
     if (prefetch_pairs_)
@@ -358,16 +390,11 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
       const auto axial_lanes = [&](const std::vector<Vec3>& a) __attribute__((always_inline)) {
         return gather_lanes([&](std::size_t l) { return a[j[l]][2] - a[i[l]][2]; });
       };
+      const Vec<2, T> planar = planar_lanes(p.position);
+      separation = {{planar[0], planar[1], axial_lanes(p.position)}};
       if (periodic) {
-        std::array<Vec<D>, lanes> offset;
-        for (std::size_t l = 0; l < lanes; ++l)
-          offset[l] = neighbours_.separation(p.position[i[l]], p.position[j[l]]);
-        for (int d = 0; d < D; ++d) {
-          separation[d] = gather_lanes([&](std::size_t l) { return offset[l][d]; });
-        }
-      } else {
-        const Vec<2, T> planar = planar_lanes(p.position);
-        separation = {{planar[0], planar[1], axial_lanes(p.position)}};
+        // The nearest image along the axis, as NeighbourList::separation makes it.
+        separation[2] = separation[2] - period * lane_nearest_integer(separation[2] / period);
       }
       const Vec<2, T> planar_velocity = planar_lanes(v);
       velocity = {{planar_velocity[0], planar_velocity[1], axial_lanes(v)}};
@@ -506,8 +533,18 @@ template void World<2>::evaluate_listed_pairs(std::size_t, const std::uint32_t*,
 template void World<3>::evaluate_listed_pairs(std::size_t, const std::uint32_t*, std::size_t,
                                               double&, std::uint32_t&, bool);
 #if defined(__x86_64__)
-template std::size_t World<2>::list_pairs_avx2(std::size_t, std::size_t, std::uint32_t*) const;
-template std::size_t World<3>::list_pairs_avx2(std::size_t, std::size_t, std::uint32_t*) const;
+template std::size_t World<2>::list_pairs_avx2<false, true>(std::size_t, std::size_t, std::size_t,
+                                                            std::uint32_t*) const;
+template std::size_t World<2>::list_pairs_avx2<false, false>(std::size_t, std::size_t, std::size_t,
+                                                             std::uint32_t*) const;
+template std::size_t World<3>::list_pairs_avx2<false, true>(std::size_t, std::size_t, std::size_t,
+                                                            std::uint32_t*) const;
+template std::size_t World<3>::list_pairs_avx2<false, false>(std::size_t, std::size_t, std::size_t,
+                                                             std::uint32_t*) const;
+template std::size_t World<3>::list_pairs_avx2<true, true>(std::size_t, std::size_t, std::size_t,
+                                                           std::uint32_t*) const;
+template std::size_t World<3>::list_pairs_avx2<true, false>(std::size_t, std::size_t, std::size_t,
+                                                            std::uint32_t*) const;
 template void World<2>::evaluate_listed_pairs_avx2(std::size_t, const std::uint32_t*, std::size_t,
                                                    double&, std::uint32_t&, bool);
 template void World<3>::evaluate_listed_pairs_avx2(std::size_t, const std::uint32_t*, std::size_t,
