@@ -52,10 +52,11 @@ class NeighbourList {
   }
   /// (skin / 2)²: a particle that has moved further since the last rebuild calls for the next.
   double half_skin_squared() const { return 0.25 * skin_ * skin_; }
-  /// x − reference, along the periodic axis the nearest image's, for a particle now at x that
-  /// was at reference when the list was made: separation(reference, x), without its division
-  /// but for the rare particle that has crossed an end since (below 0.49 periods the nearest
-  /// integer of the offset / period is ±0, and the square of the plain offset the same bits).
+  /// x − reference, along the periodic axis the nearest image's: separation(reference, x),
+  /// without its division unless the two are half a period apart along the axis, as a particle
+  /// that has crossed an end since the last rebuild, or a pair across an end, is (below 0.49
+  /// periods the nearest integer of the offset / period is ±0, and the square of the plain
+  /// offset the same bits).
   Vec<D> displacement(const Vec<D>& reference, const Vec<D>& x) const {
     const Vec<D> offset = x - reference;
     if (period_ > 0.0 && std::fabs(offset[D - 1]) >= 0.49 * period_) {

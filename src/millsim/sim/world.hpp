@@ -301,18 +301,22 @@ class World {
   /// side, then each pair's outcome applied in pair order as one at a time would. Adds the
   /// pairs' dissipation to `dissipated` and lists the collisions that end; or, with
   /// `each_apart` (a block that two threads share), keeps each pair's outcome in pair_status_
-  /// and pair_energy_ instead, to be summed in pair order once both are done. Compiled twice,
-  /// for processors with AVX2 and for any x86-64; the same bits either way.
+  /// and pair_energy_ instead, to be summed in pair order once both are done. With `stored`
+  /// (cross pairs: do_cross_pairs), outcomes kept apart too, and the k-th listed pair's force
+  /// and moment, if it touches, put in stored[k] instead of added to its particles. Compiled
+  /// twice, for processors with AVX2 and for any x86-64; the same bits either way.
+  struct PairForce;
   void evaluate_listed_pairs(std::size_t block, const std::uint32_t* listed, std::size_t count,
-                             double& dissipated, std::uint32_t& ended, bool each_apart = false);
+                             double& dissipated, std::uint32_t& ended, bool each_apart = false,
+                             PairForce* stored = nullptr);
 #if defined(__x86_64__)
   __attribute__((target("avx2"))) void evaluate_listed_pairs_avx2(
       std::size_t block, const std::uint32_t* listed, std::size_t count, double& dissipated,
-      std::uint32_t& ended, bool each_apart);
+      std::uint32_t& ended, bool each_apart, PairForce* stored);
 #endif
   [[gnu::always_inline]] inline void evaluate_listed_pairs_in_lanes(
       std::size_t block, const std::uint32_t* listed, std::size_t count, double& dissipated,
-      std::uint32_t& ended, bool each_apart);
+      std::uint32_t& ended, bool each_apart, PairForce* stored);
   /// Lists in `listed` the pairs of [begin, end) whose second particle is below `below` and that
   /// overlap or did until now, in pair order, the last one repeated up to a whole group of
   /// lanes; returns how many there are.
@@ -513,14 +517,6 @@ class World {
   // What happened to a pair in this step, and its energy: dissipated if touching, the
   // collision's total if it ended.
   enum class PairStatus : std::uint8_t { apart, touching, ended };
-  struct PairOutcome {
-    PairStatus status;
-    double energy;
-  };
-  /// Pair q alone: its contact this step. Writes the force on the second particle and the
-  /// moment both receive (scaled by their radii) to `out` if the pair touches, and returns what
-  /// happened.
-  PairOutcome evaluate_pair(std::size_t q, PairForce& out);
   // Several threads (evaluate_pair_contacts): per thread, the first of its particles and of
   // its pairs (and one past the last, at the end), for split_threads_ threads and the list of
   // rebuild split_rebuild_; the cross pairs, in pair order, and their forces this step; and per

@@ -15,47 +15,6 @@ namespace millsim {
 using namespace world_detail;
 
 template <int D>
-typename World<D>::PairOutcome World<D>::evaluate_pair(std::size_t q, PairForce& out) {
-  const auto& x = particles_.position;
-  const auto& v = velocity_now_;
-  const auto& rim = rim_speed_now_;
-  const auto& step_v = particles_.velocity;
-  const auto& step_rim = rim_speed_step_;
-  const auto& m = particles_.mass;
-  auto& history = neighbours_.history();
-  auto& touching = neighbours_.touching();
-  const std::uint32_t i = neighbours_.first()[q];
-  const std::uint32_t j = neighbours_.second()[q];
-  const Vec<D> offset = neighbours_.separation(x[i], x[j]);
-  const double distance_squared = norm_squared(offset);
-  const double reach = neighbours_.reach()[q];
-  if (distance_squared >= reach * reach) {
-    if (touching[q] == TouchState::apart) return {PairStatus::apart, 0.0};
-    const double energy = history[q].dissipated;
-    history[q] = ContactHistory<D>{};
-    touching[q] = TouchState::apart;
-    return {PairStatus::ended, energy};
-  }
-  const double distance = std::sqrt(distance_squared);
-  ContactInput<D> in;
-  in.normal = offset * (1.0 / distance);
-  in.overlap = reach - distance;
-  in.velocity = v[j] - v[i];
-  in.spin_velocity = spin_sliding(in.normal, rim[i] + rim[j]);
-  in.step_velocity = step_v[j] - step_v[i];
-  in.step_spin_velocity = spin_sliding(in.normal, step_rim[i] + step_rim[j]);
-  touching[q] = TouchState::touching;
-  // The dashpots' coefficients from the pair's effective mass, worked out here rather than
-  // read from a per-pair array made at each rebuild, whose entries, read only for the few
-  // listed pairs that touch, missed the cache.
-  const ContactDamping damping = ball_ball_law_.damping(m[i] * m[j] / (m[i] + m[j]));
-  const ContactOutput<D> result =
-      ball_ball_law_.evaluate(in, damping, history[q], settings_.time_step);
-  out = {result.force, -cross(in.normal, result.tangential_force)};
-  return {PairStatus::touching, result.dissipated};
-}
-
-template <int D>
 void World<D>::evaluate_pair_contacts() {
   // Each particle sums its pairs in pair order (pairs where it is second come first, as their
   // first particle has the lower index): the order in which one thread going down the list
@@ -287,18 +246,20 @@ void World<D>::evaluate_pair_block(std::size_t b) {
 template <int D>
 void World<D>::evaluate_listed_pairs(std::size_t block, const std::uint32_t* listed,
                                      std::size_t count, double& dissipated, std::uint32_t& ended,
-                                     bool each_apart) {
+                                     bool each_apart, PairForce* stored) {
 #if defined(__x86_64__)
   if (avx2_lanes_) {
-    evaluate_listed_pairs_avx2(block, listed, count, dissipated, ended, each_apart);
+    evaluate_listed_pairs_avx2(block, listed, count, dissipated, ended, each_apart, stored);
     return;
   }
 #endif
-  // Compiled for each value of each_apart (the kernel is inlined), so that no pair asks.
-  if (each_apart) {
-    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, true);
+  // Compiled for each way of keeping the outcomes (the kernel is inlined), so that no pair asks.
+  if (stored != nullptr) {
+    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, true, stored);
+  } else if (each_apart) {
+    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, true, nullptr);
   } else {
-    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, false);
+    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, false, nullptr);
   }
 }
 
@@ -306,11 +267,14 @@ void World<D>::evaluate_listed_pairs(std::size_t block, const std::uint32_t* lis
 template <int D>
 void World<D>::evaluate_listed_pairs_avx2(std::size_t block, const std::uint32_t* listed,
                                           std::size_t count, double& dissipated,
-                                          std::uint32_t& ended, bool each_apart) {
-  if (each_apart) {
-    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, true);
+                                          std::uint32_t& ended, bool each_apart,
+                                          PairForce* stored) {
+  if (stored != nullptr) {
+    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, true, stored);
+  } else if (each_apart) {
+    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, true, nullptr);
   } else {
-    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, false);
+    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, false, nullptr);
   }
 }
 #endif
@@ -336,7 +300,8 @@ void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, st
 template <int D>
 void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint32_t* listed,
                                               std::size_t count, double& dissipated_sum,
-                                              std::uint32_t& ended_count, bool each_apart) {
+                                              std::uint32_t& ended_count, bool each_apart,
+                                              PairForce* stored) {
   // The block's dissipation and ended count are kept in registers and written back at the
   // end: through the references each touching pair's addition was a load and a store the
   // compiler could not keep apart from the force sums' (the same additions, in the same order).
@@ -470,10 +435,15 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
       const std::array<Pair2, lanes> force_of = pairs_of(out.force);
       const auto touches = [&](std::size_t l) __attribute__((always_inline)) {
         touching[q[l]] = TouchState::touching;
-        subtract_from(particles_.force[i[l]], force_of[l]);
-        add_to(particles_.force[j[l]], force_of[l]);
-        particles_.torque[i[l]] += r[i[l]] * moment[l];
-        particles_.torque[j[l]] += r[j[l]] * moment[l];
+        if (stored != nullptr) {
+          std::memcpy(stored[k + l].force.c.data(), &force_of[l], sizeof force_of[l]);
+          stored[k + l].moment = moment[l];
+        } else {
+          subtract_from(particles_.force[i[l]], force_of[l]);
+          add_to(particles_.force[j[l]], force_of[l]);
+          particles_.torque[i[l]] += r[i[l]] * moment[l];
+          particles_.torque[j[l]] += r[j[l]] * moment[l];
+        }
         record_pair_touch(q[l], out.dissipated[l], dissipated, each_apart);
       };
       // (An ended lane's history is zeroed with the others' below.)
@@ -497,12 +467,16 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
         h.dissipated = held.dissipated[l];
         Vec<D> f;
         for (int d = 0; d < D; ++d) f[d] = out.force[d][l];
-        particles_.force[i[l]] -= f;
-        particles_.force[j[l]] += f;
         Vec3 turn;
         for (int d = 0; d < 3; ++d) turn[d] = moment[d][l];
-        particles_.torque[i[l]] += r[i[l]] * turn;
-        particles_.torque[j[l]] += r[j[l]] * turn;
+        if (stored != nullptr) {
+          stored[k + l] = {f, turn};
+        } else {
+          particles_.force[i[l]] -= f;
+          particles_.force[j[l]] += f;
+          particles_.torque[i[l]] += r[i[l]] * turn;
+          particles_.torque[j[l]] += r[j[l]] * turn;
+        }
         record_pair_touch(pair, out.dissipated[l], dissipated, each_apart);
       };
       apply_outcomes(
@@ -516,8 +490,6 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
 
 // The members defined in this file, for both dimensions (world.hpp declares World<2> and
 // World<3> extern; world.cpp instantiates the rest).
-template typename World<2>::PairOutcome World<2>::evaluate_pair(std::size_t, PairForce&);
-template typename World<3>::PairOutcome World<3>::evaluate_pair(std::size_t, PairForce&);
 template void World<2>::evaluate_pair_contacts();
 template void World<3>::evaluate_pair_contacts();
 template void World<2>::finish_pair_stage();
@@ -529,9 +501,9 @@ template std::size_t World<3>::list_pairs_for_law(std::size_t, std::size_t, std:
 template void World<2>::evaluate_pair_block(std::size_t);
 template void World<3>::evaluate_pair_block(std::size_t);
 template void World<2>::evaluate_listed_pairs(std::size_t, const std::uint32_t*, std::size_t,
-                                              double&, std::uint32_t&, bool);
+                                              double&, std::uint32_t&, bool, PairForce*);
 template void World<3>::evaluate_listed_pairs(std::size_t, const std::uint32_t*, std::size_t,
-                                              double&, std::uint32_t&, bool);
+                                              double&, std::uint32_t&, bool, PairForce*);
 #if defined(__x86_64__)
 template std::size_t World<2>::list_pairs_avx2<false, true>(std::size_t, std::size_t, std::size_t,
                                                             std::uint32_t*) const;
@@ -546,9 +518,9 @@ template std::size_t World<3>::list_pairs_avx2<true, true>(std::size_t, std::siz
 template std::size_t World<3>::list_pairs_avx2<true, false>(std::size_t, std::size_t, std::size_t,
                                                             std::uint32_t*) const;
 template void World<2>::evaluate_listed_pairs_avx2(std::size_t, const std::uint32_t*, std::size_t,
-                                                   double&, std::uint32_t&, bool);
+                                                   double&, std::uint32_t&, bool, PairForce*);
 template void World<3>::evaluate_listed_pairs_avx2(std::size_t, const std::uint32_t*, std::size_t,
-                                                   double&, std::uint32_t&, bool);
+                                                   double&, std::uint32_t&, bool, PairForce*);
 #endif
 
 }  // namespace millsim
