@@ -37,7 +37,7 @@ std::size_t World<D>::list_pairs_for_law(std::size_t begin, std::size_t end, std
                                          std::uint32_t* listed) const {
   // Four loops, so that each pair costs only the instructions its world needs (the loop is
   // bound by their number: about 37 a pair, five a cycle, in the 3D 20 k scene before), and with
-  // AVX2 two more that take four pairs at a time: in 3D worlds, periodic or not, and in 2D
+  // AVX2 the same loops taking four pairs at a time: in 3D worlds, periodic or not, and in 2D
   // worlds small enough for the caches (a larger one keeps the one-by-one loop, which fetches
   // the position of the pair 64 ahead's second particle; bench/results.md).
   const bool every_pair = below >= particles_.size();
