@@ -314,6 +314,11 @@ class World {
       std::size_t block, const std::uint32_t* listed, std::size_t count, double& dissipated,
       std::uint32_t& ended, bool each_apart, PairForce* stored);
 #endif
+  /// evaluate_listed_pairs' choice of the kernel's three ways of keeping outcomes, inlined into
+  /// both versions (AVX2 and any x86-64).
+  [[gnu::always_inline]] inline void evaluate_listed_pairs_each_way(
+      std::size_t block, const std::uint32_t* listed, std::size_t count, double& dissipated,
+      std::uint32_t& ended, bool each_apart, PairForce* stored);
   [[gnu::always_inline]] inline void evaluate_listed_pairs_in_lanes(
       std::size_t block, const std::uint32_t* listed, std::size_t count, double& dissipated,
       std::uint32_t& ended, bool each_apart, PairForce* stored);

@@ -253,6 +253,24 @@ void World<D>::evaluate_listed_pairs(std::size_t block, const std::uint32_t* lis
     return;
   }
 #endif
+  evaluate_listed_pairs_each_way(block, listed, count, dissipated, ended, each_apart, stored);
+}
+
+#if defined(__x86_64__)
+template <int D>
+void World<D>::evaluate_listed_pairs_avx2(std::size_t block, const std::uint32_t* listed,
+                                          std::size_t count, double& dissipated,
+                                          std::uint32_t& ended, bool each_apart,
+                                          PairForce* stored) {
+  evaluate_listed_pairs_each_way(block, listed, count, dissipated, ended, each_apart, stored);
+}
+#endif
+
+template <int D>
+void World<D>::evaluate_listed_pairs_each_way(std::size_t block, const std::uint32_t* listed,
+                                              std::size_t count, double& dissipated,
+                                              std::uint32_t& ended, bool each_apart,
+                                              PairForce* stored) {
   // Compiled for each way of keeping the outcomes (the kernel is inlined), so that no pair asks.
   if (stored != nullptr) {
     evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, true, stored);
@@ -262,22 +280,6 @@ void World<D>::evaluate_listed_pairs(std::size_t block, const std::uint32_t* lis
     evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, false, nullptr);
   }
 }
-
-#if defined(__x86_64__)
-template <int D>
-void World<D>::evaluate_listed_pairs_avx2(std::size_t block, const std::uint32_t* listed,
-                                          std::size_t count, double& dissipated,
-                                          std::uint32_t& ended, bool each_apart,
-                                          PairForce* stored) {
-  if (stored != nullptr) {
-    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, true, stored);
-  } else if (each_apart) {
-    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, true, nullptr);
-  } else {
-    evaluate_listed_pairs_in_lanes(block, listed, count, dissipated, ended, false, nullptr);
-  }
-}
-#endif
 
 template <int D>
 void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, std::size_t end) {
