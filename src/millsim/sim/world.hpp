@@ -440,7 +440,7 @@ class World {
     const double* radius;
     Vec<D>* velocity_now;     ///< u̇(n+1) estimates (velocity_now_)
     Spin<D>* rim_now;         ///< r ω(n+1) estimates (rim_speed_now_)
-    Spin<D>* rim_step;        ///< r ω(n+½) (rim_speed_step_)
+    Spin<D>* rim_step;        ///< r ω(n+½) (rim_speed_step_; 2D only)
     const Vec<D>* reference;  ///< positions at the last rebuild
   };
   IntegrationArrays integration_arrays();
@@ -491,13 +491,15 @@ class World {
   // work the leapfrog update does (docs/model.md, "energy account").
   std::vector<Vec<D>> velocity_now_;
   // The spins as the contact laws take them, times the radius: r ω(n), from that estimate, and
-  // r ω(n−½), over the last step. Made where the spins are (integration, or
+  // (2D only) r ω(n−½), over the last step. Made where the spins are (integration, or
   // estimate_current_velocities), so that the kernels gather one array per particle for each,
   // not two and a product: the 2D SAG scene's pair kernel 3.4 % fewer instructions, its step
-  // 1.4 % (the 3D 20 k mill's 0.4 %: its integration stores three more components; bench/
-  // results.md). The same products, so the same bits.
+  // 1.4 % (bench/results.md). The same products, so the same bits. A 3D world's kernels take
+  // r ω(n−½) from the radius and spin instead: there each sphere's three more components stored
+  // at every step cost more than the product saves (the 1e6-ball slab 2 %, the 996-ball one 2 %
+  // and the 3D 20 k mill 1 % faster on one thread without them; bench/results.md).
   std::vector<Spin<D>> rim_speed_now_;
-  std::vector<Spin<D>> rim_speed_step_;
+  std::vector<Spin<D>> rim_speed_step_;  // empty in 3D
   // Particles all of one mass (check_uniform_mass): the kernels then take the dashpots'
   // coefficients as they are instead of working them out for each contact and step (a square
   // root and two divisions for four contacts, which the 3D law waits on). A charge of several

@@ -45,7 +45,7 @@ bool World<D>::estimate_current_velocities() {
   const std::size_t count = particles_.size();
   velocity_now_.resize(count);
   rim_speed_now_.resize(count);
-  rim_speed_step_.resize(count);
+  if constexpr (D == 2) rim_speed_step_.resize(count);
   const double half_step = 0.5 * settings_.time_step;
   const auto& p = particles_;
   // Particles added since the last list: it must be made again.
@@ -55,7 +55,7 @@ bool World<D>::estimate_current_velocities() {
       velocity_now_[i] = estimate_now(p.velocity[i], p.inverse_mass[i], p.force[i], half_step);
       rim_speed_now_[i] = p.radius[i] * estimate_now(p.angular_velocity[i], p.inverse_inertia[i],
                                                      p.torque[i], half_step);
-      rim_speed_step_[i] = p.radius[i] * p.angular_velocity[i];
+      if constexpr (D == 2) rim_speed_step_[i] = p.radius[i] * p.angular_velocity[i];
     }
     return !added && neighbours_.moved_too_far(p.position, begin, end);
   });
@@ -71,9 +71,10 @@ void World<D>::check_estimates_made() const {
     const Vec<D> velocity = estimate_now(p.velocity[i], p.inverse_mass[i], p.force[i], half_step);
     const Spin<D> spin =
         estimate_now(p.angular_velocity[i], p.inverse_inertia[i], p.torque[i], half_step);
+    bool step_rim_kept = true;
+    if constexpr (D == 2) step_rim_kept = p.radius[i] * p.angular_velocity[i] == rim_speed_step_[i];
     if (!(velocity == velocity_now_[i]) || !(p.radius[i] * spin == rim_speed_now_[i]) ||
-        !(p.radius[i] * p.angular_velocity[i] == rim_speed_step_[i]) ||
-        (neighbours_.moved_too_far(i, p.position[i]) && !moved_half_skin_)) {
+        !step_rim_kept || (neighbours_.moved_too_far(i, p.position[i]) && !moved_half_skin_)) {
       std::fprintf(stderr,
                    "millsim: World::step: particle %zu was changed after the last step through a "
                    "reference to World::particles() kept from before it; ask particles() again "
@@ -275,7 +276,6 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
           __builtin_prefetch(&spin[a], 1);
           __builtin_prefetch(&velocity_now[a], 1);
           __builtin_prefetch(&rim_now[a], 1);
-          __builtin_prefetch(&rim_step[a], 1);
         }
         const std::size_t a = std::min(i + prefetch_distance, last);
         __builtin_prefetch(&inverse_mass[a]);
@@ -304,7 +304,6 @@ bool World<D>::integrate_particles_avx2(std::size_t begin, std::size_t end) {
       store_vectors(&position[i], x);
       const FourVectors w = add_scaled(load_vectors(&spin[i]), spread(ii * dt), t);
       store_vectors(&spin[i], w);
-      store_vectors(&rim_step[i], times(r, w));
       // The estimates, as estimate_now makes them.
       store_vectors(&velocity_now[i], add_scaled(v, spread(half_step * im), f));
       store_vectors(&rim_now[i], times(r, add_scaled(w, spread(half_step * ii), t)));
@@ -382,7 +381,6 @@ bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
       __builtin_prefetch(&spin[ahead], 1);
       __builtin_prefetch(&velocity_now[ahead], 1);
       __builtin_prefetch(&rim_now[ahead], 1);
-      __builtin_prefetch(&rim_step[ahead], 1);
     }
     force[i] += mass[i] * gravity;
     velocity[i] += (inverse_mass[i] * dt) * force[i];
@@ -397,7 +395,7 @@ bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
     const Vec<D> offset =
         periodic ? neighbours_.displacement(reference[i], position[i]) : position[i] - reference[i];
     velocity_now[i] = estimate_now(velocity[i], inverse_mass[i], force[i], half_step);
-    rim_step[i] = radius[i] * spin[i];
+    if constexpr (D == 2) rim_step[i] = radius[i] * spin[i];
     rim_now[i] = radius[i] * estimate_now(spin[i], inverse_inertia[i], torque[i], half_step);
     moved |= norm_squared(offset) > limit ? 1U : 0U;
   }

@@ -291,7 +291,11 @@ void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, st
       __builtin_prefetch(&velocity_now_[i]);
       __builtin_prefetch(&rim_speed_now_[i]);
       __builtin_prefetch(&p.velocity[i]);
-      __builtin_prefetch(&rim_speed_step_[i]);
+      if constexpr (D == 2) {
+        __builtin_prefetch(&rim_speed_step_[i]);
+      } else {
+        __builtin_prefetch(&p.angular_velocity[i]);
+      }
       if (!uniform_mass_) __builtin_prefetch(&p.mass[i]);
       __builtin_prefetch(&p.force[i], 1);
       __builtin_prefetch(&p.torque[i], 1);
@@ -382,7 +386,12 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
     in.spin_velocity = spin_sliding(
         in.normal, gather_spin_lanes<D>([&](std::size_t l) { return rim[i[l]] + rim[j[l]]; }));
     in.step_spin_velocity = spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
-                                           return step_rim[i[l]] + step_rim[j[l]];
+                                           if constexpr (D == 2) {
+                                             return step_rim[i[l]] + step_rim[j[l]];
+                                           } else {
+                                             return r[i[l]] * p.angular_velocity[i[l]] +
+                                                    r[j[l]] * p.angular_velocity[j[l]];
+                                           }
                                          }));
 
     ContactHistory<D, T> held;
