@@ -293,7 +293,7 @@ void World<D>::reorder_particles(const std::vector<std::uint32_t>& previous) {
   // This step's velocity estimates, made before the rebuild.
   reorder(velocity_now_, previous, 1, std::get<std::vector<Vec<D>>>(reorder_scratch_));
   reorder(rim_speed_now_, previous, 1, std::get<std::vector<Spin<D>>>(reorder_scratch_));
-  if constexpr (D == 2) {
+  if constexpr (keeps_step_rim) {
     reorder(rim_speed_step_, previous, 1, std::get<std::vector<Spin<D>>>(reorder_scratch_));
   }
   reorder(wall_slots_of_, previous, 1, std::get<std::vector<std::uint32_t>>(reorder_scratch_));

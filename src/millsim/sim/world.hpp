@@ -500,6 +500,16 @@ class World {
   // and the 3D 20 k mill 1 % faster on one thread without them; bench/results.md).
   std::vector<Spin<D>> rim_speed_now_;
   std::vector<Spin<D>> rim_speed_step_;  // empty in 3D
+  static constexpr bool keeps_step_rim = D == 2;
+  /// r ω(n−½) of particle i as the kernels take it: kept in rim_speed_step_ (2D) or multiplied
+  /// out (3D), the same product either way.
+  Spin<D> step_rim(std::uint32_t i) const {
+    if constexpr (keeps_step_rim) {
+      return rim_speed_step_[i];
+    } else {
+      return particles_.radius[i] * particles_.angular_velocity[i];
+    }
+  }
   // Particles all of one mass (check_uniform_mass): the kernels then take the dashpots'
   // coefficients as they are instead of working them out for each contact and step (a square
   // root and two divisions for four contacts, which the 3D law waits on). A charge of several

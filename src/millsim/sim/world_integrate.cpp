@@ -45,7 +45,7 @@ bool World<D>::estimate_current_velocities() {
   const std::size_t count = particles_.size();
   velocity_now_.resize(count);
   rim_speed_now_.resize(count);
-  if constexpr (D == 2) rim_speed_step_.resize(count);
+  if constexpr (keeps_step_rim) rim_speed_step_.resize(count);
   const double half_step = 0.5 * settings_.time_step;
   const auto& p = particles_;
   // Particles added since the last list: it must be made again.
@@ -55,7 +55,7 @@ bool World<D>::estimate_current_velocities() {
       velocity_now_[i] = estimate_now(p.velocity[i], p.inverse_mass[i], p.force[i], half_step);
       rim_speed_now_[i] = p.radius[i] * estimate_now(p.angular_velocity[i], p.inverse_inertia[i],
                                                      p.torque[i], half_step);
-      if constexpr (D == 2) rim_speed_step_[i] = p.radius[i] * p.angular_velocity[i];
+      if constexpr (keeps_step_rim) rim_speed_step_[i] = p.radius[i] * p.angular_velocity[i];
     }
     return !added && neighbours_.moved_too_far(p.position, begin, end);
   });
@@ -72,7 +72,9 @@ void World<D>::check_estimates_made() const {
     const Spin<D> spin =
         estimate_now(p.angular_velocity[i], p.inverse_inertia[i], p.torque[i], half_step);
     bool step_rim_kept = true;
-    if constexpr (D == 2) step_rim_kept = p.radius[i] * p.angular_velocity[i] == rim_speed_step_[i];
+    if constexpr (keeps_step_rim) {
+      step_rim_kept = p.radius[i] * p.angular_velocity[i] == rim_speed_step_[i];
+    }
     if (!(velocity == velocity_now_[i]) || !(p.radius[i] * spin == rim_speed_now_[i]) ||
         !step_rim_kept || (neighbours_.moved_too_far(i, p.position[i]) && !moved_half_skin_)) {
       std::fprintf(stderr,
@@ -395,7 +397,7 @@ bool World<D>::integrate_particles(std::size_t begin, std::size_t end) {
     const Vec<D> offset =
         periodic ? neighbours_.displacement(reference[i], position[i]) : position[i] - reference[i];
     velocity_now[i] = estimate_now(velocity[i], inverse_mass[i], force[i], half_step);
-    if constexpr (D == 2) rim_step[i] = radius[i] * spin[i];
+    if constexpr (keeps_step_rim) rim_step[i] = radius[i] * spin[i];
     rim_now[i] = radius[i] * estimate_now(spin[i], inverse_inertia[i], torque[i], half_step);
     moved |= norm_squared(offset) > limit ? 1U : 0U;
   }

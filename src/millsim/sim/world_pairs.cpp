@@ -291,7 +291,7 @@ void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, st
       __builtin_prefetch(&velocity_now_[i]);
       __builtin_prefetch(&rim_speed_now_[i]);
       __builtin_prefetch(&p.velocity[i]);
-      if constexpr (D == 2) {
+      if constexpr (keeps_step_rim) {
         __builtin_prefetch(&rim_speed_step_[i]);
       } else {
         __builtin_prefetch(&p.angular_velocity[i]);
@@ -320,7 +320,6 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
   const auto& p = particles_;
   const auto& v = velocity_now_;
   const auto& rim = rim_speed_now_;
-  const auto& step_rim = rim_speed_step_;
   const auto& r = particles_.radius;
   auto& history = neighbours_.history();
   auto& touching = neighbours_.touching();
@@ -386,12 +385,7 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
     in.spin_velocity = spin_sliding(
         in.normal, gather_spin_lanes<D>([&](std::size_t l) { return rim[i[l]] + rim[j[l]]; }));
     in.step_spin_velocity = spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
-                                           if constexpr (D == 2) {
-                                             return step_rim[i[l]] + step_rim[j[l]];
-                                           } else {
-                                             return r[i[l]] * p.angular_velocity[i[l]] +
-                                                    r[j[l]] * p.angular_velocity[j[l]];
-                                           }
+                                           return step_rim(i[l]) + step_rim(j[l]);
                                          }));
 
     ContactHistory<D, T> held;

@@ -251,14 +251,8 @@ void World<D>::evaluate_wall_laws_in_lanes(const WallContact<D>* contact, WallWo
     in.spin_velocity = spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
                                       return rim_speed_now_[particle(l)];
                                     }));
-    in.step_spin_velocity =
-        spin_sliding(in.normal, gather_spin_lanes<D>([&](std::size_t l) {
-                       if constexpr (D == 2) {
-                         return rim_speed_step_[particle(l)];
-                       } else {
-                         return p.radius[particle(l)] * p.angular_velocity[particle(l)];
-                       }
-                     }));
+    in.step_spin_velocity = spin_sliding(
+        in.normal, gather_spin_lanes<D>([&](std::size_t l) { return step_rim(particle(l)); }));
     // The dashpots' coefficients from the particle's mass (m* = m against a wall), as the pair
     // kernel has them (the same for every particle of a charge of one size).
     ContactDampingOf<T> damping;
