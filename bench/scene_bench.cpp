@@ -204,9 +204,10 @@ ArrayEstimate estimate_array_bytes(const millsim::World<D>& world) {
   const double pairs = static_cast<double>(list.pair_count());
   constexpr double index = sizeof(std::uint32_t);
   constexpr double store = 3 * sizeof(Vec<D>) + 2 * sizeof(Spin<D>) + 4 * sizeof(double);
-  // u̇(n), r ω(n), in 2D r ω(n−½), the index of its wall-contact slots; per wall candidate, the
-  // slots (id and history) and their rebuild copies.
-  constexpr double world_per_particle = sizeof(Vec<D>) + (D == 2 ? 2 : 1) * sizeof(Spin<D>) + index;
+  // u̇(n), r ω(n), r ω(n−½) where the world keeps it, the index of its wall-contact slots; per
+  // wall candidate, the slots (id and history) and their rebuild copies.
+  constexpr double world_per_particle =
+      sizeof(Vec<D>) + (millsim::World<D>::keeps_step_rim ? 2 : 1) * sizeof(Spin<D>) + index;
   constexpr double world_per_candidate =
       2 * millsim::World<D>::max_wall_contacts * (sizeof(std::int32_t) + sizeof(ContactHistory<D>));
   const double candidates_per_particle =

@@ -119,6 +119,9 @@ class World {
   /// Per particle: the shell and up to three lifters; in 3D also the walls of one end (a
   /// flat plate, or a cone and its trunnion plate) and one spare.
   static constexpr int max_wall_contacts = D == 2 ? 4 : max_mill_contacts<3> + 1;
+  /// Whether the world keeps each particle's r ω(n−½) in an array of its own for the kernels
+  /// (2D), or they multiply it out from the radius and spin (3D): see rim_speed_step_.
+  static constexpr bool keeps_step_rim = D == 2;
 
   World(const WorldSettings<D>& settings, const Walls<D>& walls);
 
@@ -499,8 +502,7 @@ class World {
   // at every step cost more than the product saves (the 1e6-ball slab 2 %, the 996-ball one 2 %
   // and the 3D 20 k mill 1 % faster on one thread without them; bench/results.md).
   std::vector<Spin<D>> rim_speed_now_;
-  std::vector<Spin<D>> rim_speed_step_;  // empty in 3D
-  static constexpr bool keeps_step_rim = D == 2;
+  std::vector<Spin<D>> rim_speed_step_;  // empty in 3D (keeps_step_rim)
   /// r ω(n−½) of particle i as the kernels take it: kept in rim_speed_step_ (2D) or multiplied
   /// out (3D), the same product either way.
   Spin<D> step_rim(std::uint32_t i) const {
