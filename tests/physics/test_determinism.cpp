@@ -361,7 +361,10 @@ TEST(Determinism, SmallSlabSplitInSmallBlocksIsTheSameOnOneTwoAndThreeThreads) {
                                  {"output.snapshot_interval=0"}));
   const World<3> scene = moving_scene<3>(plan, 0.15, 0.75, 1.0, 200);
   const Outcome<3> one = step_on(scene, 600, 1);
-  expect_identical(one, step_on(scene, 600, 2));
+  const Outcome<3> two = step_on(scene, 600, 2);
+  expect_identical(one, two);
+  // Each run did its own candidates of a wall block that both hold, in the last step at least.
+  EXPECT_GT(two.world.shared_wall_block_count(), 0u);
   expect_identical(one, step_on(scene, 600, 3));
   // A middle run with a hundredth of the weight, fewer pairs than a block: until the next
   // split the block at its start holds pairs of all three runs, and the last of the three to
@@ -379,12 +382,13 @@ TEST(Determinism, SmallSlabSplitInSmallBlocksIsTheSameOnOneTwoAndThreeThreads) {
 
 TEST(Determinism, StagesSplitThreeWaysButRunByOneThreadGiveTheSameBits) {
   // World::step splits the particles among as many runs as OpenMP offers threads, and each
-  // thread takes its runs in turn; a wall block whose candidates two runs share is done by
-  // whichever of them comes to it first. Stepped from inside another parallel region, with
+  // thread takes its runs in turn; a wall block whose candidates two runs share is done in
+  // parts, each run its own candidates. Stepped from inside another parallel region, with
   // nesting off, the step's regions get one thread, which goes through all three runs itself
-  // (and so does each shared block at the end of the earlier run instead of at the start of the
-  // later one, as three threads do). The 3D mill with end plates: thousands of wall candidates,
-  // so the runs' boundaries fall inside wall blocks.
+  // (and so does every part of a shared block, and the cross pairs into a later run at the
+  // earlier run's first block holding one instead of at the later run's start, as three
+  // threads do). The 3D mill with end plates: thousands of wall candidates, so the runs'
+  // boundaries fall inside wall blocks.
   const MillPlan plan =
       plan_mill(parse_mill_config(short_wide_mill(false), "short-wide-mill.toml"));
   const World<3> scene = moving_scene<3>(plan, 0.0, 1.0, 4.0, 200);

@@ -81,11 +81,10 @@ std::vector<double> balanced_run_shares(const std::vector<double>& shares,
                                         const std::vector<double>& weights,
                                         const std::vector<double>& seconds);
 
-/// Flags that threads set and wait on within a step: World's shared wall blocks and cross
-/// pairs, each holding a number that grows from step to step, and the counters of its blocks
-/// split between runs, zeroed before each step's threads start. Nothing is in flight between
-/// steps, so a copy starts with none, and they are made again (zero, below any step's number)
-/// when needed.
+/// Flags that threads set and wait on within a step: World's cross pairs, each holding a number
+/// that grows from step to step, and the counters of its blocks split between runs, zeroed before
+/// each step's threads start. Nothing is in flight between steps, so a copy starts with none, and
+/// they are made again (zero, below any step's number) when needed.
 class StepFlags {
  public:
   StepFlags() = default;
@@ -225,6 +224,9 @@ class World {
   /// the list alone, never from the number of threads.
   std::size_t pair_block_size() const { return pair_block_; }
   std::size_t wall_block_size() const { return wall_block_; }
+  /// Wall blocks whose candidates belong to more than one run in the last step split among
+  /// threads (each run does its own part of them), for tests.
+  std::size_t shared_wall_block_count() const { return shared_wall_blocks_.size(); }
 
   double kinetic_energy() const;        ///< translation and rotation, J
   double potential_energy() const;      ///< −Σ m g·x, J
@@ -260,9 +262,6 @@ class World {
   bool run_stages_in_one_pass();
   /// The same on several threads, each on its own run of particles (split_pairs_among).
   bool run_stages_split_among_threads();
-  /// Shared wall block k (shared_wall_blocks_[k]) done in this step, its candidates' sums kept
-  /// (shared_wall_sums_): by this thread if no other has taken it, else waited for.
-  void do_shared_wall_block(std::size_t k);
   /// The cross pairs into run `run` (their second particle in it) evaluated in this step, their
   /// forces in cross_force_ and outcomes in pair_status_ and pair_energy_: by this thread if no
   /// other has taken them, else waited for.
@@ -272,6 +271,9 @@ class World {
   void finish_mixed_part(std::size_t b);
   /// Where wall block `block` is in shared_wall_blocks_ (it must be there).
   std::size_t shared_wall_block_index(std::size_t block) const;
+  /// The shared wall blocks' sums and ended collisions, added up from their runs' parts in run
+  /// order after the runs (each part is cleared for the next step).
+  void add_up_shared_wall_blocks();
   /// Zeroes the force and torque sums of particles [begin, end).
   void zero_sums(std::size_t begin, std::size_t end);
   /// One thread's run of particles [particle_begin, particle_end), with the wall candidates
@@ -279,8 +281,9 @@ class World {
   /// stages as the pair stage completes their sums.
   class ParticleRun {
    public:
+    /// `run`: which of the step's runs it is, for its parts of shared wall blocks.
     ParticleRun(World& world, std::size_t particle_begin, std::size_t particle_end,
-                std::size_t candidate_begin, std::size_t candidate_end);
+                std::size_t candidate_begin, std::size_t candidate_end, std::size_t run = 0);
     /// Every particle of the run below `complete` has all its pair forces: does the wall blocks
     /// whose candidates all do, and advances the particles that have all their forces.
     void advance_below(std::size_t complete);
@@ -292,6 +295,7 @@ class World {
     std::size_t particle_end_;
     std::size_t candidate_begin_, candidate_end_;
     std::size_t next_wall_block_, wall_block_end_;
+    std::size_t run_;
   };
   void evaluate_pair_contacts();
   /// Block b of the pairs on this thread: its listed pairs found and evaluated, their forces
@@ -411,16 +415,37 @@ class World {
   void refresh_nearby_lifters();
   bool lifters_moved_too_far() const;
   void evaluate_wall_contacts();
+  /// A collision that ended in a parallel stage, recorded in the spectrum after it in a fixed
+  /// order (blocks in order, then in the order they were found), so any thread count gives the
+  /// same spectrum.
+  struct EndedCollision {
+    ContactType type = ContactType::ball_ball;
+    float start_angle = 0.0F;  ///< a wall collision's WallHistory::start_angle, rad
+    double energy = 0.0;
+  };
+  /// One contact's terms of its wall block's sums: dissipation, and, unless the wall is a plane
+  /// (which does not turn with the mill), torque and work.
+  struct WallTerm {
+    double dissipated = 0.0;
+    double torque = 0.0;
+    double work = 0.0;
+    bool turns = false;
+  };
+  /// One run's part of a wall block that several runs share: its contacts' terms and the
+  /// collisions that ended, in the order found. On a cache line of its own: the runs' threads
+  /// write their parts at once.
+  struct alignas(64) WallPart {
+    std::vector<WallTerm> terms;
+    std::vector<EndedCollision> ended;
+  };
   /// Block b of the wall candidates on this thread: their contacts found and evaluated, each
   /// candidate's wall forces added to its sums, the block's torque, work, dissipation and ended
   /// collisions kept.
-  /// A candidate's wall sums, kept to be added to its particle later (kept != nullptr).
-  struct WallSum {
-    Vec<D> force{};
-    Spin<D> moment{};
-    bool touches = false;  ///< whether it touches a wall (else it adds nothing)
-  };
-  void evaluate_wall_block(std::size_t b, WallSum* kept = nullptr);
+  void evaluate_wall_block(std::size_t b);
+  /// The same for the block's candidates [begin, end) alone, with the block's sums and ended
+  /// collisions kept in `part` (nullptr: the whole block, kept as evaluate_wall_block keeps
+  /// them) to be added up with the other runs' parts (add_up_shared_wall_blocks).
+  void evaluate_wall_candidates(std::size_t b, std::size_t begin, std::size_t end, WallPart* part);
   /// The wall stage's last part: the block sums added up in block order.
   void finish_wall_stage();
   /// Also makes the next step's velocity estimates, and returns whether some particle has moved
@@ -469,14 +494,6 @@ class World {
   /// have changed.
   void check_uniform_mass();
 
-  /// A collision that ended in a parallel stage, recorded in the spectrum after it in a fixed
-  /// order (blocks in order, then in the order they were found), so any thread count gives the
-  /// same spectrum.
-  struct EndedCollision {
-    ContactType type = ContactType::ball_ball;
-    float start_angle = 0.0F;  ///< a wall collision's WallHistory::start_angle, rad
-    double energy = 0.0;
-  };
   void record_ended(const std::vector<EndedCollision>& ended,
                     const std::vector<std::uint32_t>& block_ended, std::size_t block_capacity);
 
@@ -561,17 +578,16 @@ class World {
   std::vector<std::uint32_t> split_blocks_, split_block_parts_;
   StepFlags split_block_done_;
   // Per thread (run_stages_split_among_threads), the first of its wall candidates; the wall
-  // blocks that hold candidates of two threads, and their candidates' sums (wall_block_ each).
+  // blocks that hold candidates of two threads, and each run's part of them (run t's part of
+  // shared block k at k × runs + t).
   std::vector<std::uint32_t> split_candidate_;
   std::vector<std::uint32_t> shared_wall_blocks_;
-  std::vector<WallSum> shared_wall_sums_;
-  // Per shared wall block, how far the steps have done it (do_shared_wall_block); the number of
-  // steps that have split the stages among threads, this one included.
-  StepFlags shared_wall_done_;
+  std::vector<WallPart> shared_wall_parts_;
+  // The number of steps that have split the stages among threads, this one included.
   std::uint64_t split_step_count_ = 0;
   // The cross pairs by the run of their second particle (indices into cross_pairs_, run u's
   // from cross_of_run_begin_[u]), and per run how far the steps have evaluated them
-  // (do_cross_pairs, numbered as shared_wall_done_).
+  // (do_cross_pairs: the flag holds a number from split_step_count_).
   std::vector<std::uint32_t> cross_of_run_, cross_of_run_begin_;
   StepFlags cross_done_;
   // Work is split in blocks of a fixed size; each block keeps its own sums and ended

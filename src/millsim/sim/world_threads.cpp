@@ -191,7 +191,7 @@ bool World<D>::run_stages_in_one_pass() {
 template <int D>
 World<D>::ParticleRun::ParticleRun(World& world, std::size_t particle_begin,
                                    std::size_t particle_end, std::size_t candidate_begin,
-                                   std::size_t candidate_end)
+                                   std::size_t candidate_end, std::size_t run)
     : world_(world),
       advanced_(particle_begin),
       particle_end_(particle_end),
@@ -200,7 +200,8 @@ World<D>::ParticleRun::ParticleRun(World& world, std::size_t particle_begin,
       next_wall_block_(candidate_begin / world.wall_block_),
       wall_block_end_(candidate_begin < candidate_end
                           ? block_count(candidate_end, world.wall_block_)
-                          : candidate_begin / world.wall_block_) {}
+                          : candidate_begin / world.wall_block_),
+      run_(run) {}
 
 template <int D>
 void World<D>::ParticleRun::advance_below(std::size_t complete) {
@@ -216,16 +217,12 @@ void World<D>::ParticleRun::advance_below(std::size_t complete) {
     if (begin == block_begin && end == block_end) {
       world_.evaluate_wall_block(next_wall_block_);
     } else {
-      // A block shared with another run, done apart, its candidates' sums kept.
+      // A block shared with another run: this run's candidates of it, the block's sums kept
+      // apart in this run's part (add_up_shared_wall_blocks).
       const std::size_t shared = world_.shared_wall_block_index(next_wall_block_);
-      world_.do_shared_wall_block(shared);
-      const WallSum* kept = &world_.shared_wall_sums_[shared * world_.wall_block_];
-      for (std::size_t k = begin; k < end; ++k) {
-        const WallSum& sum = kept[k - block_begin];
-        if (!sum.touches) continue;
-        world_.particles_.force[candidates[k]] += sum.force;
-        world_.particles_.torque[candidates[k]] += sum.moment;
-      }
+      const auto runs = static_cast<std::size_t>(world_.split_threads_);
+      world_.evaluate_wall_candidates(next_wall_block_, begin, end,
+                                      &world_.shared_wall_parts_[shared * runs + run_]);
     }
     ++next_wall_block_;
   }
@@ -258,7 +255,7 @@ std::size_t World<D>::shared_wall_block_index(std::size_t block) const {
 
 namespace {
 
-/// Work shared by the threads of one step (World's shared wall blocks and cross pairs), done
+/// Work shared by the threads of one step (World's cross pairs), done
 /// once by whichever thread comes to it first while the others wait for it. The flag holds
 /// 2 s + 1 once step s has done it, 2 s while a thread does it; earlier steps left less.
 template <class Work>
@@ -282,10 +279,35 @@ void do_once_in_step(std::atomic<std::uint64_t>& flag, std::uint64_t step, Work&
 }  // namespace
 
 template <int D>
-void World<D>::do_shared_wall_block(std::size_t k) {
-  do_once_in_step(shared_wall_done_[k], split_step_count_, [&] {
-    evaluate_wall_block(shared_wall_blocks_[k], &shared_wall_sums_[k * wall_block_]);
-  });
+void World<D>::add_up_shared_wall_blocks() {
+  // Each part's terms and ended collisions in run order: the candidates' order, in which one
+  // thread going through the block adds them up (evaluate_wall_candidates).
+  const auto runs = static_cast<std::size_t>(split_threads_);
+  for (std::size_t k = 0; k < shared_wall_blocks_.size(); ++k) {
+    const std::size_t b = shared_wall_blocks_[k];
+    double torque = 0.0;
+    double work = 0.0;
+    double dissipated = 0.0;
+    std::uint32_t ended = 0;
+    EndedCollision* block_ended = &wall_ended_[b * wall_block_ * max_wall_contacts];
+    for (std::size_t run = 0; run < runs; ++run) {
+      WallPart& part = shared_wall_parts_[k * runs + run];
+      for (const WallTerm& term : part.terms) {
+        dissipated += term.dissipated;
+        if (term.turns) {
+          torque += term.torque;
+          work += term.work;
+        }
+      }
+      for (const EndedCollision& collision : part.ended) block_ended[ended++] = collision;
+      part.terms.clear();
+      part.ended.clear();
+    }
+    wall_block_torque_[b] = torque;
+    wall_block_work_[b] = work;
+    wall_block_dissipated_[b] = dissipated;
+    wall_block_ended_[b] = ended;
+  }
 }
 
 template <int D>
@@ -383,10 +405,11 @@ bool World<D>::run_stages_split_among_threads() {
   // particles, whose arrays are in its core's cache and whose sums it alone writes (on the 2D
   // SAG scene, handing wall blocks to whichever thread came free moved those arrays between the
   // cores at every step and cost 8 % of the step: bench/results.md). A block whose candidates
-  // belong to two threads is done by the later one first thing (do_shared_wall_block), each
-  // candidate's sums kept until its own thread adds them; the earlier thread needs it only at
-  // the end of its run. (Done before the barrier instead, it held the other thread waiting: 2D
-  // SAG, two threads, 2 % slower.)
+  // belong to two threads is done in parts, each thread its own candidates, the block's sums
+  // kept apart per part and added up after the region in run order (add_up_shared_wall_blocks).
+  // (Done whole by the later thread, first thing, it read the earlier thread's candidates from
+  // the other core and gave them back at its integration: the 3D slab of 996 balls ran 9 %
+  // slower on two threads, bench/results.md.)
   const auto& first = neighbours_.first();
   const auto& second = neighbours_.second();
   const auto& r = particles_.radius;
@@ -407,8 +430,7 @@ bool World<D>::run_stages_split_among_threads() {
       shared_wall_blocks_.push_back(static_cast<std::uint32_t>(k / wall_block_));
     }
   }
-  shared_wall_sums_.resize(shared_wall_blocks_.size() * wall_block_);
-  shared_wall_done_.reserve(shared_wall_blocks_.size());
+  shared_wall_parts_.resize(shared_wall_blocks_.size() * ranges);  // all empty between steps
   cross_done_.reserve(ranges);
   ++split_step_count_;
   split_block_done_.reserve(split_blocks_.size());
@@ -428,13 +450,6 @@ bool World<D>::run_stages_split_among_threads() {
       const std::uint32_t own_end = split_particle_[t + 1];
       // The cross pairs into this run, whose forces its particles take before any other.
       do_cross_pairs(t);
-      // A wall block shared with earlier runs that holds this run's first candidates: done now,
-      // as a rule before the earlier run's thread needs it at the end of its run (a block is
-      // done by whichever thread comes to it first, so that no thread waits for itself).
-      const std::size_t k = split_candidate_[t];
-      if (k % wall_block_ != 0 && k < candidates) {
-        do_shared_wall_block(shared_wall_block_index(k / wall_block_));
-      }
       zero_sums(own_begin, own_end);
       for (std::size_t c = 0; c < crossing; ++c) {
         const std::uint32_t q = cross_pairs_[c];
@@ -444,7 +459,7 @@ bool World<D>::run_stages_split_among_threads() {
           torque[j] += r[j] * cross_force_[c].moment;
         }
       }
-      ParticleRun run(*this, own_begin, own_end, split_candidate_[t], split_candidate_[t + 1]);
+      ParticleRun run(*this, own_begin, own_end, split_candidate_[t], split_candidate_[t + 1], t);
       std::size_t c = static_cast<std::size_t>(
           std::lower_bound(cross_pairs_.begin(), cross_pairs_.end(), split_pair_[t]) -
           cross_pairs_.begin());
@@ -498,6 +513,7 @@ bool World<D>::run_stages_split_among_threads() {
     }
   }
   finish_pair_stage();
+  add_up_shared_wall_blocks();
   finish_wall_stage();
   return moved;
 }
@@ -516,8 +532,8 @@ template void World<2>::zero_sums(std::size_t, std::size_t);
 template void World<3>::zero_sums(std::size_t, std::size_t);
 template std::size_t World<2>::shared_wall_block_index(std::size_t) const;
 template std::size_t World<3>::shared_wall_block_index(std::size_t) const;
-template void World<2>::do_shared_wall_block(std::size_t);
-template void World<3>::do_shared_wall_block(std::size_t);
+template void World<2>::add_up_shared_wall_blocks();
+template void World<3>::add_up_shared_wall_blocks();
 template void World<2>::do_cross_pairs(std::size_t);
 template void World<3>::do_cross_pairs(std::size_t);
 template void World<2>::finish_mixed_part(std::size_t);
@@ -525,9 +541,9 @@ template void World<3>::finish_mixed_part(std::size_t);
 template bool World<2>::run_stages_split_among_threads();
 template bool World<3>::run_stages_split_among_threads();
 template World<2>::ParticleRun::ParticleRun(World<2>&, std::size_t, std::size_t, std::size_t,
-                                            std::size_t);
+                                            std::size_t, std::size_t);
 template World<3>::ParticleRun::ParticleRun(World<3>&, std::size_t, std::size_t, std::size_t,
-                                            std::size_t);
+                                            std::size_t, std::size_t);
 template void World<2>::ParticleRun::advance_below(std::size_t);
 template void World<3>::ParticleRun::advance_below(std::size_t);
 

@@ -77,16 +77,27 @@ bool World<D>::clear_of_shell_and_ends(std::uint32_t i, double shell_radius) con
 }
 
 template <int D>
-void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
+void World<D>::evaluate_wall_block(std::size_t b) {
+  evaluate_wall_candidates(b, b * wall_block_,
+                           std::min(wall_candidates_.size(), (b + 1) * wall_block_), nullptr);
+}
+
+template <int D>
+void World<D>::evaluate_wall_candidates(std::size_t b, std::size_t begin, std::size_t end,
+                                        WallPart* part) {
   const double dt = settings_.time_step;
-  const std::size_t candidates = wall_candidates_.size();
   double torque = 0.0;
   double work = 0.0;
   double dissipated = 0.0;
   std::uint32_t ended = 0;
   EndedCollision* block_ended = &wall_ended_[b * wall_block_ * max_wall_contacts];
-  const std::size_t begin = b * wall_block_;
-  const std::size_t end = std::min(candidates, begin + wall_block_);
+  const auto end_collision = [&](const EndedCollision& collision) {
+    if (part != nullptr) {
+      part->ended.push_back(collision);
+    } else {
+      block_ended[ended++] = collision;
+    }
+  };
   // The block's contacts, found candidate by candidate (each in its slot of wall-contact
   // history) and written where the law reads them, then their contact law worked out
   // lane_count at a time, then each candidate's contacts added up in the order they were found.
@@ -156,9 +167,9 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
     }
     for (unsigned ended_slots = held & ~seen; ended_slots != 0; ended_slots &= ended_slots - 1) {
       const int slot = std::countr_zero(ended_slots);
-      block_ended[ended++] = {.type = wall_contact_type(walls_.kind_of(slot_id[slot])),
-                              .start_angle = static_cast<float>(slot_history[slot].start_angle),
-                              .energy = slot_history[slot].dissipated};
+      end_collision({.type = wall_contact_type(walls_.kind_of(slot_id[slot])),
+                     .start_angle = static_cast<float>(slot_history[slot].start_angle),
+                     .energy = slot_history[slot].dissipated});
       slot_history[slot] = WallHistory{};
       slot_id[slot] = -1;
     }
@@ -167,10 +178,7 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
   for (std::size_t k = begin; k < end; ++k) {
     // A candidate touching no wall adds nothing: its sums, begun at +0 and so never −0 (in
     // round-to-nearest x + y is −0 only if both are), would stay the same bits.
-    if (first_work[k - begin] == first_work[k - begin + 1]) {
-      if (kept != nullptr) kept[k - begin].touches = false;
-      continue;
-    }
+    if (first_work[k - begin] == first_work[k - begin + 1]) continue;
     const std::uint32_t i = wall_candidates_[k];
     Vec<D> force{};
     Spin<D> moment{};
@@ -179,21 +187,26 @@ void World<D>::evaluate_wall_block(std::size_t b, WallSum* kept) {
       const WallContact<D>& contact = found_list[w];
       force += done.force;
       moment += done.moment;
+      const bool turns = contact.kind != WallKind::plane;
+      if (part != nullptr) {
+        // Added up after the runs, in this order (add_up_shared_wall_blocks).
+        part->terms.push_back({.dissipated = done.dissipated,
+                               .torque = turns ? axial_moment(contact.point, done.force) : 0.0,
+                               .work = turns ? dot(done.force, contact.wall_velocity) * dt : 0.0,
+                               .turns = turns});
+        continue;
+      }
       dissipated += done.dissipated;
-      if (contact.kind != WallKind::plane) {
+      if (turns) {
         torque += axial_moment(contact.point, done.force);
         work += dot(done.force, contact.wall_velocity) * dt;
       }
     }
-    // Added to the particle's sums after its pairs (they are all done), before gravity; or
-    // kept to be added then.
-    if (kept != nullptr) {
-      kept[k - begin] = {force, moment, true};
-      continue;
-    }
+    // Added to the particle's sums after its pairs (they are all done), before gravity.
     particles_.force[i] += force;
     particles_.torque[i] += moment;
   }
+  if (part != nullptr) return;
   wall_block_torque_[b] = torque;
   wall_block_work_[b] = work;
   wall_block_dissipated_[b] = dissipated;
@@ -306,8 +319,10 @@ template bool World<2>::mill_has_cones() const;
 template bool World<3>::mill_has_cones() const;
 template bool World<2>::clear_of_shell_and_ends(std::uint32_t, double) const;
 template bool World<3>::clear_of_shell_and_ends(std::uint32_t, double) const;
-template void World<2>::evaluate_wall_block(std::size_t, WallSum*);
-template void World<3>::evaluate_wall_block(std::size_t, WallSum*);
+template void World<2>::evaluate_wall_block(std::size_t);
+template void World<3>::evaluate_wall_block(std::size_t);
+template void World<2>::evaluate_wall_candidates(std::size_t, std::size_t, std::size_t, WallPart*);
+template void World<3>::evaluate_wall_candidates(std::size_t, std::size_t, std::size_t, WallPart*);
 template void World<2>::evaluate_wall_laws(const WallContact<2>*, WallWork*, std::size_t);
 template void World<3>::evaluate_wall_laws(const WallContact<3>*, WallWork*, std::size_t);
 #if defined(__x86_64__)
