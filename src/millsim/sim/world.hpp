@@ -431,6 +431,21 @@ class World {
     double work = 0.0;
     bool turns = false;
   };
+  /// A wall block's sums, made contact by contact in the candidates' order: by one thread
+  /// going through the block, or from the runs' parts (add_up_shared_wall_blocks), with the
+  /// same additions.
+  struct WallBlockSum {
+    double torque = 0.0;
+    double work = 0.0;
+    double dissipated = 0.0;
+    void add(const WallTerm& term) {
+      dissipated += term.dissipated;
+      if (term.turns) {
+        torque += term.torque;
+        work += term.work;
+      }
+    }
+  };
   /// One run's part of a wall block that several runs share: its contacts' terms and the
   /// collisions that ended, in the order found. On a cache line of its own: the runs' threads
   /// write their parts at once.

@@ -285,27 +285,19 @@ void World<D>::add_up_shared_wall_blocks() {
   const auto runs = static_cast<std::size_t>(split_threads_);
   for (std::size_t k = 0; k < shared_wall_blocks_.size(); ++k) {
     const std::size_t b = shared_wall_blocks_[k];
-    double torque = 0.0;
-    double work = 0.0;
-    double dissipated = 0.0;
+    WallBlockSum sum;
     std::uint32_t ended = 0;
     EndedCollision* block_ended = &wall_ended_[b * wall_block_ * max_wall_contacts];
     for (std::size_t run = 0; run < runs; ++run) {
       WallPart& part = shared_wall_parts_[k * runs + run];
-      for (const WallTerm& term : part.terms) {
-        dissipated += term.dissipated;
-        if (term.turns) {
-          torque += term.torque;
-          work += term.work;
-        }
-      }
+      for (const WallTerm& term : part.terms) sum.add(term);
       for (const EndedCollision& collision : part.ended) block_ended[ended++] = collision;
       part.terms.clear();
       part.ended.clear();
     }
-    wall_block_torque_[b] = torque;
-    wall_block_work_[b] = work;
-    wall_block_dissipated_[b] = dissipated;
+    wall_block_torque_[b] = sum.torque;
+    wall_block_work_[b] = sum.work;
+    wall_block_dissipated_[b] = sum.dissipated;
     wall_block_ended_[b] = ended;
   }
 }

@@ -86,9 +86,7 @@ template <int D>
 void World<D>::evaluate_wall_candidates(std::size_t b, std::size_t begin, std::size_t end,
                                         WallPart* part) {
   const double dt = settings_.time_step;
-  double torque = 0.0;
-  double work = 0.0;
-  double dissipated = 0.0;
+  WallBlockSum sum;
   std::uint32_t ended = 0;
   EndedCollision* block_ended = &wall_ended_[b * wall_block_ * max_wall_contacts];
   const auto end_collision = [&](const EndedCollision& collision) {
@@ -187,19 +185,15 @@ void World<D>::evaluate_wall_candidates(std::size_t b, std::size_t begin, std::s
       const WallContact<D>& contact = found_list[w];
       force += done.force;
       moment += done.moment;
-      const bool turns = contact.kind != WallKind::plane;
-      if (part != nullptr) {
-        // Added up after the runs, in this order (add_up_shared_wall_blocks).
-        part->terms.push_back({.dissipated = done.dissipated,
-                               .torque = turns ? axial_moment(contact.point, done.force) : 0.0,
-                               .work = turns ? dot(done.force, contact.wall_velocity) * dt : 0.0,
-                               .turns = turns});
-        continue;
+      WallTerm term{.dissipated = done.dissipated, .turns = contact.kind != WallKind::plane};
+      if (term.turns) {
+        term.torque = axial_moment(contact.point, done.force);
+        term.work = dot(done.force, contact.wall_velocity) * dt;
       }
-      dissipated += done.dissipated;
-      if (turns) {
-        torque += axial_moment(contact.point, done.force);
-        work += dot(done.force, contact.wall_velocity) * dt;
+      if (part != nullptr) {
+        part->terms.push_back(term);  // added up after the runs, in this order
+      } else {
+        sum.add(term);
       }
     }
     // Added to the particle's sums after its pairs (they are all done), before gravity.
@@ -207,9 +201,9 @@ void World<D>::evaluate_wall_candidates(std::size_t b, std::size_t begin, std::s
     particles_.torque[i] += moment;
   }
   if (part != nullptr) return;
-  wall_block_torque_[b] = torque;
-  wall_block_work_[b] = work;
-  wall_block_dissipated_[b] = dissipated;
+  wall_block_torque_[b] = sum.torque;
+  wall_block_work_[b] = sum.work;
+  wall_block_dissipated_[b] = sum.dissipated;
   wall_block_ended_[b] = ended;
 }
 
