@@ -461,6 +461,13 @@ class World {
   /// collisions kept in `part` (nullptr: the whole block, kept as evaluate_wall_block keeps
   /// them) to be added up with the other runs' parts (add_up_shared_wall_blocks).
   void evaluate_wall_candidates(std::size_t b, std::size_t begin, std::size_t end, WallPart* part);
+  /// Block b's sums and count of ended collisions, kept for finish_wall_stage.
+  void keep_wall_block(std::size_t b, const WallBlockSum& sum, std::uint32_t ended) {
+    wall_block_torque_[b] = sum.torque;
+    wall_block_work_[b] = sum.work;
+    wall_block_dissipated_[b] = sum.dissipated;
+    wall_block_ended_[b] = ended;
+  }
   /// The wall stage's last part: the block sums added up in block order.
   void finish_wall_stage();
   /// Also makes the next step's velocity estimates, and returns whether some particle has moved

@@ -255,9 +255,9 @@ std::size_t World<D>::shared_wall_block_index(std::size_t block) const {
 
 namespace {
 
-/// Work shared by the threads of one step (World's cross pairs), done
-/// once by whichever thread comes to it first while the others wait for it. The flag holds
-/// 2 s + 1 once step s has done it, 2 s while a thread does it; earlier steps left less.
+/// Work shared by the threads of one step (World's cross pairs), done once by whichever thread
+/// comes to it first while the others wait for it. The flag holds 2 s + 1 once step s has done
+/// it, 2 s while a thread does it; earlier steps left less.
 template <class Work>
 void do_once_in_step(std::atomic<std::uint64_t>& flag, std::uint64_t step, Work&& work) {
   const std::uint64_t taken = 2 * step;
@@ -295,10 +295,7 @@ void World<D>::add_up_shared_wall_blocks() {
       part.terms.clear();
       part.ended.clear();
     }
-    wall_block_torque_[b] = sum.torque;
-    wall_block_work_[b] = sum.work;
-    wall_block_dissipated_[b] = sum.dissipated;
-    wall_block_ended_[b] = ended;
+    keep_wall_block(b, sum, ended);
   }
 }
 

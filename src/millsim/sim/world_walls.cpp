@@ -201,10 +201,7 @@ void World<D>::evaluate_wall_candidates(std::size_t b, std::size_t begin, std::s
     particles_.torque[i] += moment;
   }
   if (part != nullptr) return;
-  wall_block_torque_[b] = sum.torque;
-  wall_block_work_[b] = sum.work;
-  wall_block_dissipated_[b] = sum.dissipated;
-  wall_block_ended_[b] = ended;
+  keep_wall_block(b, sum, ended);
 }
 
 template <int D>
