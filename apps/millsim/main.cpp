@@ -238,6 +238,7 @@ int run_scene_command(const millsim::SceneConfig& scene, const JobOptions& optio
   prepare_output_directory(out, output_location(scene, options),
                            {"summary.json", "trajectory.csv", "final.csv"});
   if (!options.quiet) fmt::print("millsim: running scene {}\n", scene.source);
+  warn(plan.warnings);
   ProgressLine progress(!options.quiet);
   const millsim::SceneResult result = millsim::run_scene(
       plan, out, [&](double time, double total) { progress(time, total, -1.0); });
@@ -291,6 +292,7 @@ int scene_info(const millsim::SceneConfig& scene) {
                                : std::string("start and end only");
   fmt::print("simulated time        {:.4g} s: {} steps; trajectory rows {}\n", scene.duration,
              plan.steps, rows);
+  warn(plan.warnings);
   return 0;
 }
 

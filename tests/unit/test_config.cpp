@@ -11,6 +11,7 @@
 
 #include "millsim/core/error.hpp"
 #include "millsim/io/config.hpp"
+#include "millsim/io/toml_reader.hpp"
 
 namespace millsim {
 namespace {
@@ -280,6 +281,81 @@ TEST(Config, RefusesImpossibleValues) {
   expect_has(error_of(porosity), {at_line(porosity, "porosity"), "charge.porosity", "< 1"});
   const std::string nan = with(base_config, "length", "length = nan");
   expect_has(error_of(nan), {at_line(nan, "length"), "mill.length", "nan is not allowed"});
+  // Values that would make the mill's mass or power infinite, or a ball's mass zero.
+  const std::string long_mill = with(base_config, "length", "length = 1.7e308");
+  expect_has(error_of(long_mill), {at_line(long_mill, "length"), "mill.length",
+                                   "1.7e+308 is not allowed", "at most 1000"});
+  const std::string wide_mill = with(base_config, "diameter", "diameter = 101");
+  expect_has(error_of(wide_mill), {at_line(wide_mill, "diameter"), "mill.diameter",
+                                   "101 is not allowed", "at most 100"});
+  EXPECT_EQ(
+      parse_mill_config(base_config, file_name, {"mill.length=1000", "mill.diameter=100"}).length,
+      1000.0);
+  const std::string tiny_ball = with(base_config, "ball_diameter", "ball_diameter = 1e-100");
+  expect_has(error_of(tiny_ball), {at_line(tiny_ball, "ball_diameter"), "charge.ball_diameter",
+                                   "1e-100 is not allowed", "from 0.0001 (0.1 mm)"});
+  EXPECT_EQ(
+      parse_mill_config(base_config, file_name, {"charge.ball_diameter=0.0001"}).sizes[0].diameter,
+      1e-4);
+}
+
+TEST(Config, RefusesADottedKeyOfTooManyPartsBeforeParsingIt) {
+  // toml++ takes each part one call deeper: 35 000 parts ran out of stack (a crash, no message).
+  std::string deep;
+  for (int i = 0; i < 35000; ++i) deep += "x.";
+  const std::string text = std::string(base_config) + deep + "y = 1\n";
+  expect_has(error_of(text),
+             {std::string(file_name) + ":" + std::to_string(line_of(text, "x.")),
+              "a dotted key or table name of more than 64 parts", "allowed: at most 64 parts"});
+  const std::string header = std::string(base_config) + "[" + deep + "y]\n";
+  expect_has(error_of(header), {"more than 64 parts"});
+  // 64 parts are read (and, in [output], refused as an unknown key: the next check).
+  std::string most;
+  for (int i = 0; i < 63; ++i) most += "x.";
+  expect_has(error_of(std::string(base_config) + most + "y = 1\n"), {"output.x: unknown key"});
+  // Dots in strings, comments and numbers are no key's.
+  std::string dots(200, '.');
+  const MillConfig quiet = parse_mill_config(
+      with(base_config, "directory", "directory = \"" + dots + "\" # " + dots), file_name);
+  EXPECT_EQ(quiet.output_directory, dots);
+  EXPECT_FALSE(line_of_overlong_key("a = [" + std::string(100, '1') + ".5, 1.5, 2.5]").has_value());
+  EXPECT_FALSE(line_of_overlong_key("a = '''\n" + dots + "\n'''\nb = 1").has_value());
+  EXPECT_EQ(line_of_overlong_key("a = \"\"\"\nx\n\"\"\"\n\n" + most + "x.y = 1"), 5u);
+}
+
+TEST(Config, RefusesAnUnknownKeyWithAControlCharacterShowingAllOfIt) {
+  // A NUL in the key ended the message at it ("mill.spe"): it is escaped now.
+  const std::string text = with(base_config, "speed", "\"spe\\u0000ed\" = 0.5\nspeed = 0.5");
+  expect_has(error_of(text),
+             {at_line(text, "\"spe"), "mill.spe\\x00ed: unknown key", "allowed in [mill]"});
+}
+
+TEST(Config, RefusesABlankCaseNameAndATolerancePastOne) {
+  // validate printed the first as a row with no name, the second as ±10000%.
+  expect_has(error_of(base_config, {"reference.case=\" \"", "reference.measured_power_kw=1"}),
+             {"command line (--set reference.case=\" \")", "reference.case", "\" \" is not allowed",
+              "more than blanks"});
+  expect_has(error_of(base_config, {"reference.case=x", "reference.measured_power_kw=1",
+                                    "reference.tolerance=100"}),
+             {"reference.tolerance", "100 is not allowed", "at most 1 (100 %)"});
+  const MillConfig one = parse_mill_config(
+      base_config, file_name,
+      {"reference.case=x", "reference.measured_power_kw=1", "reference.tolerance=1"});
+  ASSERT_TRUE(one.reference.has_value());
+  EXPECT_EQ(one.reference->tolerance, 1.0);
+}
+
+TEST(Config, RefusesAnOverrideWithMoreTomlAfterItsValue) {
+  // The second line was parsed as a key of its own and dropped unread.
+  expect_has(error_of(base_config, {"mill.speed=0.7\nbogus.key = \"x\""}),
+             {"command line (--set mill.speed=0.7\\nbogus.key = \"x\")", "more than one value",
+              "allowed: one value"});
+  // A value over several lines is still one value.
+  const MillConfig sizes = parse_mill_config(
+      base_config, file_name,
+      {"charge.sizes=[{diameter = 0.05, mass_fraction = 0.6},\n {diameter = 0.04, mass_fraction "
+       "= 0.4}]"});
+  EXPECT_EQ(sizes.sizes.size(), 2u);
 }
 
 TEST(Config, RefusesLiftersThatFillTheMill) {
@@ -400,6 +476,11 @@ TEST(Config, RefusesMoreMeasuredRevolutionsThanRun) {
               "allowed: a whole number of revolutions from 1"});
   expect_has(error_of(base_config, {"simulation.revolutions=1.5"}),
              {"simulation.revolutions", "1.5 is not a whole number"});
+  // 1e16 is a whole number, but a float that far out stands for several: it says so.
+  expect_has(error_of(base_config, {"simulation.seed=1e16"}),
+             {"simulation.seed", "1e+16 is a float beyond 2^53", "written as an integer"});
+  EXPECT_EQ(parse_mill_config(base_config, file_name, {"simulation.seed=10000000000000000"}).seed,
+            10000000000000000UL);
 }
 
 TEST(Config, AValidOverrideChangesTheValueAndIsRecordedAsFromTheCommandLine) {

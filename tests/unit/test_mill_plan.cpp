@@ -243,10 +243,10 @@ TEST(MillPlan, RefusesMillsThatCannotRunNamingTheKey) {
   in_rpm.speed_fraction.reset();
   in_rpm.speed_rpm = 1e6;
   expect_has(plan_error(in_rpm), {"mill.speed_rpm", "at most 5 times critical, 229.5 rpm"});
-  // A 1 km mill 30 % full of 5.08 cm discs at a 2D void fraction of 0.2:
-  // 0.3 × π 500² × 0.8 / (π/4 × 0.0508²) = 9.3e7 discs.
-  expect_has(plan_error(lab_mill({"mill.diameter=1000"})),
-             {"charge.filling", "9.3e+07 discs", "at most 5e+07"});
+  // A 100 m mill 30 % full of 5 mm discs at a 2D void fraction of 0.2:
+  // 0.3 × π 50² × 0.8 / (π/4 × 0.005²) = 9.6e7 discs.
+  expect_has(plan_error(lab_mill({"mill.diameter=100", "charge.ball_diameter=0.005"})),
+             {"charge.filling", "9.6e+07 discs", "at most 5e+07"});
   // 1e-9 of the volume: 75 discs at J = 0.3 become 2.5e-7 of one.
   expect_has(plan_error(lab_mill({"charge.filling=1e-9"})), {"charge.filling", "rounds to none"});
   // 1 s of settling, half the spin-up's quarter period and 6 revolutions of 60/22.950170 =

@@ -119,6 +119,18 @@ TEST(SceneConfig, AutoTimeStepIsATwentiethOfTheShortestContact) {
   EXPECT_LT(plan.time_step, plan.critical_time_step);
 }
 
+TEST(SceneConfig, WarnsOfAGivenTimeStepCoarserThanATenthOfTheShortestContact) {
+  // The contact above lasts 4.1199387e-4 s: 5e-5 s is 8.2 steps of it, stable but coarse.
+  const millsim::ScenePlan coarse = millsim::plan_scene(scene(drop, {"simulation.time_step=5e-5"}));
+  ASSERT_EQ(coarse.warnings.size(), 1u);
+  for (const char* part : {"command line (--set simulation.time_step=5e-5)", "simulation.time_step",
+                           "in 8.24 steps, fewer than 10", "2.06e-05 s"}) {
+    EXPECT_NE(coarse.warnings[0].find(part), std::string::npos) << coarse.warnings[0];
+  }
+  EXPECT_TRUE(millsim::plan_scene(scene(drop, {"simulation.time_step=4e-5"})).warnings.empty());
+  EXPECT_TRUE(millsim::plan_scene(scene(drop)).warnings.empty());
+}
+
 TEST(SceneConfig, RefusesAnUnstableTimeStepAndGivesTheLimit) {
   expect_refused(drop, {"simulation.time_step=1e-3"},
                  {"simulation.time_step", "unstable", "stability limit"});
@@ -250,7 +262,10 @@ TEST(SceneConfig, RefusesSpeedsSizesAndPlacesBeyondAnyScene) {
       fast, {},
       {"drop.toml:8", "particles[0].velocity", "1e+300 is out of range", "within ±10000"});
   expect_refused(drop, {"particles=[{position = [0.0, 0.0, 0.5], diameter = 1e3}]"},
-                 {"particles[0].diameter", "at most 100"});
+                 {"particles[0].diameter", "from 0.0001 to 100"});
+  // A particle of 1e-300 m has no mass in doubles: its contact duration was inf, then nan.
+  expect_refused(drop, {"particles=[{position = [0.0, 0.0, 0.5], diameter = 1e-300}]"},
+                 {"particles[0].diameter", "1e-300 is not allowed", "from 0.0001 to 100"});
   std::string far(drop);
   far.replace(far.find("normal = [0.0, 0.0, 2.0]"), 24, "normal = [1e300, 1e300, 1e300]");
   expect_refused(far, {}, {"walls[0].normal", "out of range"});

@@ -216,9 +216,13 @@ void read_mill(TableReader section, MillConfig& config) {
   section.allow_keys({"diameter", "length", "speed", "speed_rpm", "periodic", "slab_length",
                       "cone_angle", "cone_length", "lifters"},
                      belongs_elsewhere);
+  // The upper bounds keep every derived figure finite (a mill 1e308 m long weighed inf kg and
+  // drew inf kW); the largest mills built are 13 m across and 15 m long.
   config.diameter = section.number("diameter", std::nullopt,
-                                   "a number of metres > 0 (inside the shell)", positive);
-  config.length = section.number("length", std::nullopt, "a number of metres > 0", positive);
+                                   "a number of metres > 0, at most 100 (inside the shell)",
+                                   [](double d) { return d > 0.0 && d <= 100.0; });
+  config.length = section.number("length", std::nullopt, "a number of metres > 0, at most 1000",
+                                 [](double l) { return l > 0.0 && l <= 1000.0; });
   const std::string speed_rule = "a fraction of critical speed > 0, at most 5";
   const std::string rpm_rule = "a number of rpm > 0";
   config.speed_fraction =
@@ -238,9 +242,10 @@ void read_mill(TableReader section, MillConfig& config) {
 
 void read_sizes(TableReader& section, MillConfig& config) {
   const double radius = 0.5 * config.diameter;
-  const std::string size_rule =
-      fmt::format("a number of metres > 0 and < {} (half the mill radius)", 0.5 * radius);
-  const auto fits = [&](double d) { return d > 0.0 && d < 0.5 * radius; };
+  // At least 0.1 mm: a ball of 1e-100 m has a mass of 0 in doubles, and no contact duration.
+  const std::string size_rule = fmt::format(
+      "a number of metres from 0.0001 (0.1 mm) to below {} (half the mill radius)", 0.5 * radius);
+  const auto fits = [&](double d) { return d >= 1e-4 && d < 0.5 * radius; };
   const std::string choices =
       "one of ball_diameter (one size), top_size (a graded charge) or sizes (a list)";
   std::vector<std::string_view> given;
@@ -362,9 +367,16 @@ void read_reference(TableReader section, MillConfig& config) {
                      belongs_elsewhere);
   ReferencePower r;
   r.case_name = section.string("case", std::nullopt, "the case name (a string)");
+  if (r.case_name.find_first_not_of(" \t") == std::string::npos) {
+    // It names the case's row of validate's table.
+    section.fail_at("case", fmt::format("\"{}\" is not allowed; allowed: the case name, a string "
+                                        "with more than blanks (e.g. \"2D-a\")",
+                                        r.case_name));
+  }
   r.measured_kw = section.number("measured_power_kw", std::nullopt, "a number of kW > 0", positive);
   r.paper_kw = section.optional_number("paper_power_kw", "a number of kW > 0", positive);
-  r.tolerance = section.number("tolerance", 0.15, "a fraction > 0", positive);
+  r.tolerance = section.number("tolerance", 0.15, "a fraction > 0, at most 1 (100 %)",
+                               [](double t) { return t > 0.0 && t <= 1.0; });
   config.reference = r;
 }
 
@@ -396,6 +408,12 @@ namespace {
 /// The TOML document of a config, with the overrides applied.
 toml::table parse_document(std::string_view toml_text, const std::string& source,
                            const std::vector<std::string>& overrides) {
+  if (const auto line = line_of_overlong_key(toml_text)) {
+    throw InputError(fmt::format(
+        "{}:{}: a dotted key or table name of more than {} parts; allowed: at most {} parts, as "
+        "in mill.lifters.count",
+        source, *line, max_key_parts, max_key_parts));
+  }
   toml::table document;
   try {
     document = toml::parse(toml_text, std::string_view(source));
@@ -544,8 +562,10 @@ SceneParticle read_scene_particle(TableReader p, int dimension) {
     particle.angular_velocity =
         read_vector(p, "angular_velocity", 3, "rad/s; default [0, 0, 0]", false, 1e6);
   }
-  particle.diameter = p.number("diameter", std::nullopt, "a number of metres > 0, at most 100",
-                               [](double d) { return d > 0.0 && d <= 100.0; });
+  // At least 0.1 mm: a particle of 1e-300 m has a mass of 0 in doubles, and no contact
+  // duration.
+  particle.diameter = p.number("diameter", std::nullopt, "a number of metres from 0.0001 to 100",
+                               [](double d) { return d >= 1e-4 && d <= 100.0; });
   particle.density = p.number("density", 7800.0, "a number of kg/m3 from 10 to 1e5 (default 7800)",
                               [](double rho) { return rho >= 10.0 && rho <= 1e5; });
   const std::string material = p.string(

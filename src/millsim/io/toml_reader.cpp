@@ -47,6 +47,10 @@ std::string printable(std::string_view text) {
   return out;
 }
 
+bool bare_key_character(char c) {
+  return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-';
+}
+
 std::string type_name(const toml::node& node) {
   switch (node.type()) {
     case toml::node_type::string:
@@ -129,15 +133,26 @@ std::optional<std::string_view> closest_key(std::string_view key,
 namespace {
 
 bool valid_key_part(std::string_view part) {
-  return !part.empty() && std::all_of(part.begin(), part.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-';
-  });
+  return !part.empty() && std::all_of(part.begin(), part.end(), bare_key_character);
 }
 
 /// A TOML document `value = <text>` whose nodes name `option` as their source.
 toml::table parse_override_value(std::string_view text, const std::string& option) {
+  if (line_of_overlong_key(text)) {
+    throw InputError(fmt::format(
+        "command line ({}): the value holds a dotted key of more than {} parts; allowed: {}",
+        option, max_key_parts, override_allowed));
+  }
   try {
-    return toml::parse(fmt::format("value = {}", text), std::string_view(option));
+    toml::table parsed = toml::parse(fmt::format("value = {}", text), std::string_view(option));
+    if (parsed.size() != 1) {
+      // More TOML after the value's end (on a line of its own): it would be dropped unread.
+      throw InputError(fmt::format(
+          "command line ({}): more than one value (the text after the first line's value is "
+          "more TOML); allowed: one value, e.g. --set mill.speed=0.75",
+          option));
+    }
+    return parsed;
   } catch (const toml::parse_error&) {
     // Not a TOML value: take the text as a plain string.
   }
@@ -161,6 +176,67 @@ toml::table parse_override_value(std::string_view text, const std::string& optio
 }
 
 }  // namespace
+
+std::optional<std::size_t> line_of_overlong_key(std::string_view text) {
+  // A chain is a run of key parts (bare words or quoted strings) joined by dots, blanks allowed
+  // around the dots; anything else ends it. `dots` counts the current chain's dots.
+  std::size_t line = 1;
+  std::size_t dots = 0;
+  bool after_part = false;  // the last thing read was a key part (or a word of a value)
+  std::size_t i = 0;
+  const std::size_t n = text.size();
+  // Skips the string that starts at i (its opening quote), counting its lines.
+  const auto skip_string = [&] {
+    const char quote = text[i];
+    const std::string_view three = quote == '"' ? std::string_view("\"\"\"") : "'''";
+    const bool multi_line = text.substr(i, 3) == three;
+    const bool escapes = quote == '"';
+    i += multi_line ? 3 : 1;
+    while (i < n) {
+      const char c = text[i];
+      if (escapes && c == '\\') {
+        if (i + 1 < n && text[i + 1] == '\n') ++line;
+        i += 2;
+        continue;
+      }
+      if (c == '\n') {
+        if (!multi_line) return;  // an unclosed string: the parser will say so
+        ++line;
+      }
+      if (c == quote && (!multi_line || text.substr(i, 3) == three)) {
+        i += multi_line ? 3 : 1;
+        // A multi-line string may end in one or two quotes of its own before its three.
+        while (multi_line && i < n && text[i] == quote) ++i;
+        return;
+      }
+      ++i;
+    }
+  };
+  while (i < n) {
+    const char c = text[i];
+    if (c == '"' || c == '\'') {
+      skip_string();
+      after_part = true;
+      continue;
+    }
+    if (c == '#') {
+      while (i < n && text[i] != '\n') ++i;
+      continue;
+    }
+    if (c == '.' && after_part) {
+      if (++dots >= max_key_parts) return line;
+      after_part = false;
+    } else if (bare_key_character(c)) {
+      after_part = true;
+    } else if (c != ' ' && c != '\t') {
+      dots = 0;
+      after_part = false;
+      if (c == '\n') ++line;
+    }
+    ++i;
+  }
+  return std::nullopt;
+}
 
 std::string describe_value(const toml::node& node) {
   return describe(node);
@@ -217,11 +293,13 @@ void TableReader::allow_keys(std::initializer_list<std::string_view> keys,
       if (!h.empty()) remark = fmt::format(" ({})", h);
     }
     const std::string where = source_location(value, file_);
+    // The name as written, control characters escaped (a NUL would end the message there).
+    const std::string shown = printable(name);
     if (path_.empty()) {
       throw InputError(fmt::format("{}: {}: unknown {}{}; allowed at the top level: the tables {}",
-                                   where, name, value.is_table() ? "table" : "key", remark, list));
+                                   where, shown, value.is_table() ? "table" : "key", remark, list));
     }
-    throw InputError(fmt::format("{}: {}: unknown key{}; allowed in {}: {}", where, dotted(name),
+    throw InputError(fmt::format("{}: {}: unknown key{}; allowed in {}: {}", where, dotted(shown),
                                  remark, table_name(), list));
   }
 }
@@ -307,11 +385,17 @@ long TableReader::integer(std::string_view key, std::optional<long> fallback,
   if (const auto* i = n->as_integer()) {
     value = static_cast<long>(i->get());
   } else if (const auto* f = n->as_floating_point()) {
-    // 8.0 is a whole number written as a float; 8.5, nan and 1e300 are not.
+    // 8.0 is a whole number written as a float; 8.5 and nan are not. Beyond 2^53 a float
+    // stands for several whole numbers (1e16 for 1e16 ± 1): such a one must be an integer.
     constexpr double exact = 9007199254740992.0;  // 2^53
     const double x = f->get();
-    if (!std::isfinite(x) || std::floor(x) != x || std::abs(x) > exact) {
+    if (!std::isfinite(x) || std::floor(x) != x) {
       fail_at(key, fmt::format("{} is not a whole number; allowed: {}", describe(*n), allowed));
+    }
+    if (std::abs(x) > exact) {
+      fail_at(key, fmt::format("{} is a float beyond 2^53, which cannot say which whole number it "
+                               "is; allowed: {}, written as an integer (no point or exponent)",
+                               describe(*n), allowed));
     }
     value = static_cast<long>(x);
   } else {

@@ -27,6 +27,15 @@ using KeyLocations = std::map<std::string, std::string, std::less<>>;
 /// `fallback_file` when the node has no line.
 std::string source_location(const toml::node& node, std::string_view fallback_file);
 
+/// The most parts a dotted key or table name may have (millsim's own keys have at most three).
+inline constexpr std::size_t max_key_parts = 64;
+
+/// The line (from 1) of the first dotted key or table name in TOML `text` with more than
+/// max_key_parts parts, if any. Read before the text is parsed: toml++ takes each part of a
+/// dotted key one call deeper, and a key of 35 000 parts ran millsim out of stack. Strings and
+/// comments are skipped, and a number's decimal point is one dot, not a chain of them.
+std::optional<std::size_t> line_of_overlong_key(std::string_view text);
+
 /// A value as written ("0.9" with its quotes, 8.5, true), or its kind ("an array").
 std::string describe_value(const toml::node& node);
 

@@ -13,12 +13,11 @@
 #include "millsim/core/error.hpp"
 #include "millsim/core/version.hpp"
 #include "millsim/io/partial_file.hpp"
+#include "millsim/sim/charge.hpp"
 
 namespace millsim {
 namespace {
 
-/// Steps per contact duration of the "auto" time step, as for mills (plan_mill).
-constexpr double steps_per_contact = 20.0;
 /// "auto" for a scene whose particles can touch nothing: this many steps over the duration.
 constexpr double steps_without_contacts = 1000.0;
 
@@ -164,6 +163,15 @@ ScenePlan plan_scene(const SceneConfig& config) {
           shortest / steps_per_contact, steps_per_contact));
     }
     plan.time_step = *config.time_step;
+    if (std::isfinite(shortest) && plan.time_step * fewest_steps_per_contact > shortest) {
+      plan.warnings.push_back(fmt::format(
+          "{}: simulation.time_step: {:.4g} s resolves the shortest contact ({:.3g} s) in {:.3g} "
+          "steps, fewer than {:.0f}: the results may be inaccurate (\"auto\" takes {:.3g} s, "
+          "1/{:.0f} of it)",
+          config.location_of("simulation.time_step"), plan.time_step, shortest,
+          shortest / plan.time_step, fewest_steps_per_contact,
+          std::min(shortest / steps_per_contact, 0.25 * critical), steps_per_contact));
+    }
   } else {
     // As for mills: 1/20 of the shortest contact, at most a quarter of the stability limit.
     plan.time_step = std::isfinite(shortest)

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "millsim/io/config.hpp"
 #include "millsim/sim/world.hpp"
@@ -21,6 +22,9 @@ struct ScenePlan {
   double shortest_contact = 0.0;
   long steps = 0;             ///< whole steps of time_step that reach the duration
   long trajectory_every = 0;  ///< steps between trajectory rows; 0: only start and end
+  /// Doubts about the plan that do not stop the run (a given time step coarser than 1/10 of the
+  /// shortest contact), each naming the file, line and key.
+  std::vector<std::string> warnings;
 };
 
 /// Checks the time step against the stability limit (refusing an unstable one with the limit)
