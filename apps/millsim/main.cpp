@@ -105,7 +105,17 @@ class ProgressLine {
 /// Refuses an output directory `out` that exists as something other than a directory;
 /// `location` names where it was given.
 void refuse_a_file_as_directory(const std::filesystem::path& out, const std::string& location) {
-  if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
+  // The non-throwing status: a path the system cannot look up (a name too long, a parent that
+  // is a file) is refused here with the key, not reported as a failed run.
+  std::error_code error;
+  const std::filesystem::file_status state = std::filesystem::status(out, error);
+  if (error && state.type() != std::filesystem::file_type::not_found) {
+    throw millsim::InputError(
+        fmt::format("{}: output.directory: cannot use \"{}\" ({}); allowed: a directory that "
+                    "can be created and written",
+                    location, out.string(), error.message()));
+  }
+  if (std::filesystem::exists(state) && !std::filesystem::is_directory(state)) {
     throw millsim::InputError(
         fmt::format("{}: output.directory: \"{}\" exists and is not a directory; allowed: a "
                     "directory path",

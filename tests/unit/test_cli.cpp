@@ -454,6 +454,20 @@ TEST_F(Cli, AnOutputDirectoryThatCannotBeMadeIsBadInputNamingTheOption) {
       << o.err;
 }
 
+TEST_F(Cli, AnOutputDirectoryWhoseNameTheSystemRefusesIsBadInputNamingTheOption) {
+  // A name of 300 letters is longer than any file system takes (255 bytes): the lookup's error
+  // was thrown out of the planning as a failed run (exit 1, no key).
+  write_config(base_config);
+  const std::string name(300, 'a');
+  const Outcome o = millsim("run mill.toml -q --out " + name + " " + tiny_run);
+  EXPECT_EQ(o.status, 2) << o.err;
+  EXPECT_TRUE(o.err.starts_with("millsim: error: command line (--out " + name +
+                                "): output.directory: cannot use \"" + name + "\" ("))
+      << o.err;
+  EXPECT_NE(o.err.find("allowed: a directory that can be created and written"), std::string::npos)
+      << o.err;
+}
+
 TEST_F(Cli, ARunRemovesTheResultsAnEarlierRunLeftInItsDirectory) {
   // A run stopped half-way must not leave the last run's power.csv beside its own files.
   fs::create_directories(work_ / "out");

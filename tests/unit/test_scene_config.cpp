@@ -179,6 +179,10 @@ TEST(SceneConfig, RefusesAZeroWallNormal) {
   std::string text(drop);
   text.replace(text.find("[0.0, 0.0, 2.0]"), 15, "[0.0, 0.0, 0.0]");
   expect_refused(text, {}, {"walls[0].normal", "zero vector"});
+  // A normal too short to square (1e-200² underflows to 0) is not zero: it is scaled first.
+  std::string tiny(drop);
+  tiny.replace(tiny.find("[0.0, 0.0, 2.0]"), 15, "[0.0, 0.0, 1e-200]");
+  EXPECT_EQ(scene(tiny).walls[0].normal, (std::array<double, 3>{0.0, 0.0, 1.0}));
 }
 
 TEST(SceneConfig, RefusesAParticleStartingInsideAWall) {

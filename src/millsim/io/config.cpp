@@ -586,14 +586,22 @@ SceneWall read_scene_wall(TableReader w, int dimension) {
   wall.point = read_vector(w, "point", dimension, "a point of the plane, m", true, 1e6);
   wall.normal =
       read_vector(w, "normal", dimension, "not zero; points to the particles' side", true, 1e6);
-  double length = 0.0;
-  for (const double x : wall.normal) length += x * x;
-  length = std::sqrt(length);
-  if (!(length > 0.0)) {
+  double largest = 0.0;
+  for (const double x : wall.normal) largest = std::max(largest, std::abs(x));
+  if (!(largest > 0.0)) {
     w.fail_at("normal",
               fmt::format("a zero vector is not allowed; allowed: {}",
                           vector_rule(dimension, "not zero; points to the particles' side")));
   }
+  double length = 0.0;
+  for (const double x : wall.normal) length += x * x;
+  if (!(length > 0.0)) {
+    // Components so small that their squares underflow ([1e-200, 1e-200]): scaled up first.
+    for (double& x : wall.normal) x /= largest;
+    length = 0.0;
+    for (const double x : wall.normal) length += x * x;
+  }
+  length = std::sqrt(length);
   for (double& x : wall.normal) x /= length;
   return wall;
 }

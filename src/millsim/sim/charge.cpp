@@ -349,7 +349,8 @@ World<D> build_mill_world(const MillPlan& plan) {
       if (!placed) {
         throw InputError(fmt::format(
             "{}: charge.filling: could not place {} {} of {} m without overlap in the mill "
-            "(placed {}); lower the filling or use smaller balls{}",
+            "(placed {}); allowed: a filling whose balls fit the mill: lower the filling or use "
+            "smaller balls{}",
             config.location_of("charge.filling"), plan.particle_count, D == 2 ? "discs" : "balls",
             c.diameter, particles.size(),
             D == 3 && !config.periodic ? ", or make the mill longer (mill.length)" : ""));
