@@ -481,6 +481,13 @@ TEST(Config, RefusesMoreMeasuredRevolutionsThanRun) {
              {"simulation.seed", "1e+16 is a float beyond 2^53", "written as an integer"});
   EXPECT_EQ(parse_mill_config(base_config, file_name, {"simulation.seed=10000000000000000"}).seed,
             10000000000000000UL);
+  // A number TOML cannot hold is kept as text by --set: the message says why it is a string.
+  expect_has(error_of(base_config, {"simulation.revolutions=9999999999999999999"}),
+             {"simulation.revolutions",
+              "\"9999999999999999999\" is a string (not read as a "
+              "number: TOML takes whole numbers up to"});
+  const std::string quoted = error_of(base_config, {"simulation.revolutions=\"5\""});
+  expect_has(quoted, {"\"5\" is a string; allowed:"});
 }
 
 TEST(Config, AValidOverrideChangesTheValueAndIsRecordedAsFromTheCommandLine) {

@@ -81,6 +81,25 @@ std::string describe(const toml::node& node) {
 
 /// "\"0.9\" is a string", "a table is not allowed here": the first half of a type error.
 std::string wrong_type(const toml::node& node) {
+  if (const auto* text = node.as_string(); text != nullptr && from_override(node)) {
+    // A --set value TOML could not read is kept as text: say why, where it looks like a number
+    // (and was not typed as a string: --set KEY="0.9").
+    const std::string_view option = *node.source().path;
+    const std::string_view value =
+        trim(option.substr(std::min(option.size(), option.find('=') + 1)));
+    const std::string_view typed =
+        value.starts_with('"') || value.starts_with('\'') ? std::string_view() : text->get();
+    const bool digits = !typed.empty() && std::all_of(typed.begin(), typed.end(), [](char c) {
+      return std::isdigit(static_cast<unsigned char>(c)) != 0 || c == '+' || c == '-' || c == '.' ||
+             c == 'e' || c == 'E' || c == '_';
+    });
+    if (digits && std::isdigit(static_cast<unsigned char>(typed.back())) != 0) {
+      return fmt::format(
+          "{} is a string (not read as a number: TOML takes whole numbers up to "
+          "9223372036854775807 and floats up to 1.8e308)",
+          describe(node));
+    }
+  }
   if (node.is_string() || node.is_number() || node.is_boolean()) {
     return fmt::format("{} is {}", describe(node), type_name(node));
   }
