@@ -105,8 +105,9 @@ class ProgressLine {
 /// Refuses an output directory `out` that exists as something other than a directory;
 /// `location` names where it was given.
 void refuse_a_file_as_directory(const std::filesystem::path& out, const std::string& location) {
-  // The non-throwing status: a path the system cannot look up (a name too long, a parent that
-  // is a file) is refused here with the key, not reported as a failed run.
+  // The non-throwing status: a path the system cannot look up (a name too long) is refused here
+  // with the key, not reported as a failed run. (One below a file reads as not found, and
+  // creating it fails below.)
   std::error_code error;
   const std::filesystem::file_status state = std::filesystem::status(out, error);
   if (error && state.type() != std::filesystem::file_type::not_found) {

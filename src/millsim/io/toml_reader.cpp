@@ -95,8 +95,9 @@ std::string wrong_type(const toml::node& node) {
     });
     if (digits && std::isdigit(static_cast<unsigned char>(typed.back())) != 0) {
       return fmt::format(
-          "{} is a string (not read as a number: TOML takes whole numbers up to "
-          "9223372036854775807 and floats up to 1.8e308)",
+          "{} is a string (TOML did not read it as a number: its numbers have a digit on "
+          "each side of a point, no leading zero, and lie within ±9223372036854775807 if "
+          "whole, ±1.8e308 if not)",
           describe(node));
     }
   }

@@ -145,8 +145,8 @@ MillPlan plan_mill(const MillConfig& config) {
       plan.discs.push_back({s.diameter, one, 0});
     }
   }
-  // Counted in doubles and checked before they become whole numbers: a mill of kilometres or
-  // balls of microns would overflow them, or ask for more memory than any machine has.
+  // Counted in doubles and checked before they become whole numbers: a 100 m mill of 5 mm balls
+  // (within the reader's bounds) would ask for more memory than any machine has.
   double total = 0.0;
   for (const double n : counts) total += n;
   const std::string count_keys =
