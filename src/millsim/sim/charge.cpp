@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include "millsim/core/constants.hpp"
 #include "millsim/core/error.hpp"
@@ -65,6 +66,17 @@ double cone_bed_volume(double radius, double trunnion_radius, double cone_length
     sum += weight * circle_area_below(r, level);
   }
   return sum * h / 3.0;
+}
+
+std::optional<std::string> coarse_step_warning(const std::string& where, double time_step,
+                                               double shortest, double automatic) {
+  if (!(time_step * fewest_steps_per_contact > shortest)) return std::nullopt;
+  return fmt::format(
+      "{}: simulation.time_step: {:.4g} s resolves the shortest contact ({:.3g} s) in {:.3g} "
+      "steps, fewer than {:.0f}: the results may be inaccurate (\"auto\" takes {:.3g} s, 1/{:.0f} "
+      "of it)",
+      where, time_step, shortest, shortest / time_step, fewest_steps_per_contact, automatic,
+      steps_per_contact);
 }
 
 MillPlan plan_mill(const MillConfig& config) {
@@ -205,13 +217,9 @@ MillPlan plan_mill(const MillConfig& config) {
     plan.time_step = *config.time_step;
     const double shortest =
         std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall);
-    if (plan.time_step * fewest_steps_per_contact > shortest) {
-      plan.warnings.push_back(fmt::format(
-          "{}: simulation.time_step: {:.4g} s resolves the shortest contact ({:.3g} s) in {:.3g} "
-          "steps, fewer than {:.0f}: the results may be inaccurate (\"auto\" takes {:.3g} s, "
-          "1/{:.0f} of it)",
-          config.location_of("simulation.time_step"), plan.time_step, shortest,
-          shortest / plan.time_step, fewest_steps_per_contact, accurate, steps_per_contact));
+    if (auto warning = coarse_step_warning(config.location_of("simulation.time_step"),
+                                           plan.time_step, shortest, accurate)) {
+      plan.warnings.push_back(std::move(*warning));
     }
   } else {
     // 1/20 of the shortest contact, and never above a quarter of the stability limit: with a

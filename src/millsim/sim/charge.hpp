@@ -2,6 +2,7 @@
 // and the charge placed in the mill.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,12 @@ inline constexpr double steps_per_contact = 20.0;
 /// A time step given in the config with fewer steps than this per shortest contact is stable
 /// but coarse (MODEL.md §4: "at least ~10–20"): the run is made, with a warning.
 inline constexpr double fewest_steps_per_contact = 10.0;
+
+/// The warning for a time step given in a config (at `where`, its file and line) that takes
+/// fewer than fewest_steps_per_contact steps over the `shortest` contact duration, naming
+/// `automatic`, the step "auto" would take; nothing for a finer step. Mills and scenes alike.
+std::optional<std::string> coarse_step_warning(const std::string& where, double time_step,
+                                               double shortest, double automatic);
 
 /// One size of the simulated charge: discs in 2D, spheres in 3D.
 struct DiscClass {

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include "millsim/core/constants.hpp"
 #include "millsim/core/error.hpp"
@@ -163,14 +164,11 @@ ScenePlan plan_scene(const SceneConfig& config) {
           shortest / steps_per_contact, steps_per_contact));
     }
     plan.time_step = *config.time_step;
-    if (std::isfinite(shortest) && plan.time_step * fewest_steps_per_contact > shortest) {
-      plan.warnings.push_back(fmt::format(
-          "{}: simulation.time_step: {:.4g} s resolves the shortest contact ({:.3g} s) in {:.3g} "
-          "steps, fewer than {:.0f}: the results may be inaccurate (\"auto\" takes {:.3g} s, "
-          "1/{:.0f} of it)",
-          config.location_of("simulation.time_step"), plan.time_step, shortest,
-          shortest / plan.time_step, fewest_steps_per_contact,
-          std::min(shortest / steps_per_contact, 0.25 * critical), steps_per_contact));
+    // (Particles that can touch nothing have an infinite shortest contact: no warning.)
+    if (auto warning = coarse_step_warning(
+            config.location_of("simulation.time_step"), plan.time_step, shortest,
+            std::min(shortest / steps_per_contact, 0.25 * critical))) {
+      plan.warnings.push_back(std::move(*warning));
     }
   } else {
     // As for mills: 1/20 of the shortest contact, at most a quarter of the stability limit.
