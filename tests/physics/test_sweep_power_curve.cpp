@@ -149,6 +149,25 @@ TEST_F(SweepPowerCurve, AFailedPointIsReportedAndTheOthersStillRun) {
   EXPECT_NE(o.out.find("failed: "), std::string::npos) << o.out;
 }
 
+TEST_F(SweepPowerCurve, AListValueMayHoldCommasInsideAnArray) {
+  // Two size distributions: the commas inside each array belong to it, not to the list.
+  const std::string one_size = "[{diameter = 0.025, mass_fraction = 1}]";
+  const std::string two_sizes =
+      "[{diameter = 0.03, mass_fraction = 0.5}, {diameter = 0.02, mass_fraction = 0.5}]";
+  const Outcome o = millsim("sweep " + quoted(small_mill) + " --vary " +
+                            quoted("charge.sizes=" + one_size + "," + two_sizes) + " -q --out d" +
+                            tiny_run + tiny_speed);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const auto rows = read_csv(work_ / "d" / "sweep.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].at("charge.sizes"), one_size);
+  EXPECT_EQ(rows[1].at("charge.sizes"), two_sizes);
+  EXPECT_EQ(rows[0].at("status"), "ok");
+  EXPECT_EQ(rows[1].at("status"), "ok");
+  // The same filling in smaller discs on average: more of them.
+  EXPECT_GT(std::stoi(rows[1].at("particle_count")), std::stoi(rows[0].at("particle_count")));
+}
+
 TEST_F(SweepPowerCurve, ABadKeyOrSpecRefusesTheWholeSweepAndWritesNothing) {
   const Outcome key = millsim("sweep " + quoted(small_mill) + " --vary mill.sped=0.3,0.5 --out s");
   EXPECT_EQ(key.status, 2);

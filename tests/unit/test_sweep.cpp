@@ -51,6 +51,23 @@ TEST(Sweep, AListKeepsItsValuesAsWritten) {
   EXPECT_EQ(parse_vary("mill.speed=0.5").values, (Values{"0.5"}));
 }
 
+TEST(Sweep, AListSplitsOnlyBetweenValues) {
+  // Commas and colons inside a TOML string, array or inline table belong to the value.
+  EXPECT_EQ(parse_vary("charge.sizes=[{diameter = 0.1, mass_fraction = 1}],"
+                       "[{diameter = 0.08, mass_fraction = 0.5}, {diameter = 0.05, "
+                       "mass_fraction = 0.5}]")
+                .values,
+            (Values{"[{diameter = 0.1, mass_fraction = 1}]",
+                    "[{diameter = 0.08, mass_fraction = 0.5}, {diameter = 0.05, mass_fraction = "
+                    "0.5}]"}));
+  EXPECT_EQ(parse_vary("reference.case=\"a,b:c\", 'd,e', \"f\\\",g\"").values,
+            (Values{"\"a,b:c\"", "'d,e'", "\"f\\\",g\""}));
+  // An unclosed string or bracket keeps the rest whole; the TOML reader refuses it later.
+  EXPECT_EQ(parse_vary("charge.sizes=[0.1, 0.2").values, (Values{"[0.1, 0.2"}));
+  // A colon outside them still makes a range.
+  EXPECT_EQ(parse_vary("mill.speed=0.5:0.7:0.1").values, (Values{"0.5", "0.6", "0.7"}));
+}
+
 TEST(Sweep, RefusesABadSpecNamingTheArgumentAndWhatIsAllowed) {
   const std::string allowed = "allowed: KEY=START:STOP:STEP";
   for (const std::string argument :

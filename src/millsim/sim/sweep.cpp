@@ -19,7 +19,8 @@ namespace {
 
 constexpr std::string_view vary_allowed =
     "KEY=START:STOP:STEP (numbers; STEP not 0 and leading from START towards STOP) or "
-    "KEY=V1,V2,... (each a TOML value or text, as for --set), e.g. mill.speed=0.3:0.9:0.1 or "
+    "KEY=V1,V2,... (each a TOML value or text, as for --set; commas inside a string, array or "
+    "table belong to the value), e.g. mill.speed=0.3:0.9:0.1 or "
     "charge.filling=0.2,0.3,0.4";
 
 /// A range's values are counted as whole steps from START; STOP is included when it is within
@@ -54,14 +55,44 @@ std::optional<double> read_number(std::string_view text) {
   return value;
 }
 
+/// Where `separator` occurs in `text` outside TOML strings ("...", '...') and outside brackets
+/// and braces, so that a value such as "a,b" or [{diameter = 0.1, mass_fraction = 1}] stays
+/// whole. An unclosed string or bracket runs to the end: the value is then refused by the TOML
+/// reader, with its key, as --set's would be.
+std::vector<std::size_t> top_level_positions(std::string_view text, char separator) {
+  std::vector<std::size_t> positions;
+  int depth = 0;
+  char quote = 0;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quote != 0) {
+      if (quote == '"' && c == '\\') {
+        ++i;  // an escape: the next character is not the closing quote
+      } else if (c == quote) {
+        quote = 0;
+      }
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '[' || c == '{') {
+      ++depth;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    } else if (c == separator && depth == 0) {
+      positions.push_back(i);
+    }
+  }
+  return positions;
+}
+
 std::vector<std::string> split(std::string_view text, char separator) {
   std::vector<std::string> parts;
-  for (std::size_t start = 0;;) {
-    const auto at = text.find(separator, start);
-    parts.emplace_back(trim(text.substr(start, at == std::string_view::npos ? at : at - start)));
-    if (at == std::string_view::npos) return parts;
+  std::size_t start = 0;
+  for (const std::size_t at : top_level_positions(text, separator)) {
+    parts.emplace_back(trim(text.substr(start, at - start)));
     start = at + 1;
   }
+  parts.emplace_back(trim(text.substr(start)));
+  return parts;
 }
 
 std::vector<std::string> range_values(const std::vector<std::string>& parts,
@@ -150,7 +181,7 @@ SweepAxis parse_vary(std::string_view argument) {
         where));
   }
   const std::string_view spec = trim(argument.substr(equals + 1));
-  if (spec.find(':') != std::string_view::npos) {
+  if (!top_level_positions(spec, ':').empty()) {
     const std::vector<std::string> parts = split(spec, ':');
     if (parts.size() != 3) {
       throw InputError(fmt::format("{}: \"{}\" has {} parts separated by ':', not 3; allowed: {}",
