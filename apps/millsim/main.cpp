@@ -129,9 +129,10 @@ void refuse_a_file_as_directory(const std::filesystem::path& out, const std::str
 enum class Snapshots { untouched, removed, made };
 
 /// Creates the output directory `out`, checks that a file can be written in it, and removes the
-/// `results` (and snapshots/, for a mill) an earlier run left in it, so that a run stopped half-way
-/// leaves no mixture of two runs' files. Called before the simulation, so that a directory that
-/// cannot take the results is refused before any time is spent. `location` names where the
+/// `results`, their NAME.partial files (and snapshots/, for a mill) an earlier run left in it, so
+/// that a run stopped half-way leaves no mixture of two runs' files. Called before the
+/// simulation, so that a directory that cannot take the results is refused before any time is
+/// spent. `location` names where the
 /// directory was given (config line, --set or --out) for the message if it cannot be used.
 void prepare_output_directory(const std::filesystem::path& out, const std::string& location,
                               std::initializer_list<const char*> results,
@@ -183,12 +184,26 @@ void prepare_output_directory(const std::filesystem::path& out, const std::strin
     if (!made.empty()) std::filesystem::remove_all(made, ignored);
     throw refuse("write in", why);
   }
+  // Each result and its NAME.partial (what a killed run leaves) are removed: one that cannot be
+  // (a directory of that name, not empty) would only fail the write at the end of the run.
+  const auto clear = [&](const std::filesystem::path& path) {
+    try {
+      std::filesystem::remove(path);
+    } catch (const std::filesystem::filesystem_error& error) {
+      throw refuse("clear earlier results from",
+                   fmt::format("{}: {}", path.filename().string(), error.code().message()));
+    }
+  };
+  for (const char* name : results) {
+    clear(out / name);
+    clear(out / (std::string(name) + ".partial"));
+  }
   try {
-    for (const char* name : results) std::filesystem::remove(out / name);
     if (snapshots != Snapshots::untouched) std::filesystem::remove_all(out / "snapshots");
     if (snapshots == Snapshots::made) std::filesystem::create_directories(out / "snapshots");
   } catch (const std::filesystem::filesystem_error& error) {
-    throw refuse("clear earlier results from", error.code().message());
+    throw refuse("clear earlier results from",
+                 fmt::format("snapshots: {}", error.code().message()));
   }
 }
 

@@ -487,6 +487,23 @@ TEST_F(Cli, ARunRemovesTheResultsAnEarlierRunLeftInItsDirectory) {
   EXPECT_EQ(read_all(work_ / "out" / "notes.txt"), "stale\n");
 }
 
+TEST_F(Cli, AResultsPartialNameTakenByADirectoryIsRefusedBeforeTheRun) {
+  write_config(base_config);
+  // Results are written as NAME.partial and renamed. A directory of the user's (not empty)
+  // named spectrum.csv.partial would fail that write at the end of the run, after the other
+  // results were written: refused before the run starts, and left as it is.
+  fs::create_directories(work_ / "taken" / "spectrum.csv.partial" / "mine");
+  const Outcome taken = millsim(std::string("run mill.toml -o taken -q ") + tiny_run);
+  EXPECT_EQ(taken.status, 2) << taken.err;
+  EXPECT_NE(taken.err.find("command line (--out taken): output.directory: cannot clear earlier "
+                           "results from \"taken\" (spectrum.csv.partial: "),
+            std::string::npos)
+      << taken.err;
+  EXPECT_FALSE(fs::exists(work_ / "taken" / "summary.json"));
+  EXPECT_FALSE(fs::exists(work_ / "taken" / "power.csv"));
+  EXPECT_TRUE(fs::exists(work_ / "taken" / "spectrum.csv.partial" / "mine"));
+}
+
 TEST_F(Cli, AnUnknownCommandIsNamed) {
   const Outcome o = millsim("frobnicate mill.toml");
   EXPECT_EQ(o.status, 2) << o.err;
