@@ -76,7 +76,6 @@ std::string belongs_elsewhere(std::string_view key) {
 
 namespace config_detail {
 
-/// simulation.time_step: "auto" (empty) or a number of seconds > 0.
 std::optional<double> read_time_step(TableReader& section) {
   const std::string step_rule = "\"auto\" or a number of seconds > 0";
   const toml::node* step = section.node("time_step");
@@ -357,7 +356,6 @@ ContactMaterial read_material(TableReader section) {
   return m;
 }
 
-/// output.directory: a non-empty path, default "out".
 std::string read_output_directory(TableReader& section) {
   const std::string directory_rule = "a directory path (a non-empty string)";
   std::string directory = section.string("directory", "out", directory_rule);
