@@ -587,12 +587,13 @@ TEST(Mill3D, TumblesBelowCriticalAndCentrifugesAboveIt) {
 
   // Tumbling: the charge is held up on the rising side (+x), its centre of mass well off the
   // axis, and the mill draws a power like the lab mill's 0.6 kW (seen: 0.64 kW, centre
-  // (0.168, −0.115) m, orbital speed ratio 0.42).
+  // (0.168, −0.113) m, orbital speed ratio 0.74: the bed turns with the shell, the balls
+  // cascading down its surface against the turn).
   EXPECT_GT(tumbling.power_kw, 0.3);
   EXPECT_GT(tumbling.charge_centre[0], 0.1 * radius);
-  EXPECT_LT(tumbling.orbital_speed_ratio, 0.8);
+  EXPECT_LT(tumbling.orbital_speed_ratio, 0.9);
 
-  // Centrifuged: the charge rides round with the shell (seen: 0.997 and 1.000), its centre of
+  // Centrifuged: the charge rides round with the shell (seen: 0.996 and 0.999), its centre of
   // mass on the axis (seen: 0.0063 and 0.0027 m, against 0.204 m tumbling), so lifting it
   // takes no torque. What power is left is the inner layers rolling to and fro in the bays
   // as gravity turns round them, still dying away in the fourth revolution and chaotic (seen:

@@ -34,26 +34,27 @@ PowerInterval interval(const EnergySample& from, const EnergySample& to, double 
   return p;
 }
 
-/// Centre of mass of the particles in the cross-section (x, y) and their mean angular speed
-/// about the mill axis.
+}  // namespace
+
 template <int D>
-std::pair<Vec2, double> charge_motion(const World<D>& world) {
-  const auto& p = world.particles();
+std::pair<Vec2, double> charge_motion(const ParticleStore<D>& p) {
   Vec2 moment{};
   double mass = 0.0;
-  double angular_speed = 0.0;
+  double angular_momentum = 0.0;
+  double inertia = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     const Vec2 at{{p.position[i][0], p.position[i][1]}};
     const Vec2 velocity{{p.velocity[i][0], p.velocity[i][1]}};
     moment += p.mass[i] * at;
     mass += p.mass[i];
-    const double r2 = norm_squared(at);
-    if (r2 > 0.0) angular_speed += cross(at, velocity) / r2;
+    angular_momentum += p.mass[i] * cross(at, velocity);
+    inertia += p.mass[i] * norm_squared(at);
   }
-  return {moment * (1.0 / mass), angular_speed / static_cast<double>(p.size())};
+  return {moment * (1.0 / mass), inertia > 0.0 ? angular_momentum / inertia : 0.0};
 }
 
-}  // namespace
+template std::pair<Vec2, double> charge_motion<2>(const ParticleStore<2>&);
+template std::pair<Vec2, double> charge_motion<3>(const ParticleStore<3>&);
 
 double spin_up_time(const MillPlan& plan) {
   return plan.spin_up_time;
@@ -103,6 +104,7 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
   EnergySample series_start = revolution_start;
   double revolution_torque_time = 0.0;
   double series_torque_time = 0.0;
+  double window_torque_time = 0.0;
   int next_revolution = 1;
   bool measuring = false;
   int motion_samples = 0;
@@ -125,12 +127,13 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
     world.step();
     revolution_torque_time += world.shell_torque() * dt;
     series_torque_time += world.shell_torque() * dt;
+    if (measuring) window_torque_time += world.shell_torque() * dt;
     const double now_turned = mill.angle - start_angle;
     if (now_turned >= series_angle * static_cast<double>(result.series.size() + 1)) {
       const EnergySample now = sample(world);
       result.series.push_back(interval(series_start, now, series_torque_time, plan.power_scale));
       if (measuring) {
-        const auto [centre, angular_speed] = charge_motion(world);
+        const auto [centre, angular_speed] = charge_motion(world.particles());
         result.charge_centre += centre;
         result.orbital_speed_ratio += angular_speed / plan.angular_speed;
         result.charge_profile->add(world.particles().position, world.particles().radius);
@@ -167,7 +170,9 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
   const double dissipated = b.dissipated - a.dissipated;
   result.power_kw = plan.power_scale * work / window / 1000.0;
   result.power_dissipation_kw = plan.power_scale * dissipated / window / 1000.0;
-  result.torque_nm = result.power_kw * 1000.0 / plan.angular_speed;
+  // The mean torque, as power.csv's rows have it: T ω = P only while ω is steady (a window that
+  // takes in the spin-up has a mean torque above P / ω).
+  result.torque_nm = plan.power_scale * window_torque_time / window;
   const double change =
       (b.kinetic - a.kinetic) + (b.potential - a.potential) + (b.stored - a.stored);
   result.energy_balance_error = std::abs(work - (change + dissipated)) / std::abs(work);

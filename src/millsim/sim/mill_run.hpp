@@ -4,11 +4,13 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "millsim/measure/charge_profile.hpp"
 #include "millsim/measure/shell_impacts.hpp"
 #include "millsim/measure/spectrum.hpp"
+#include "millsim/particles/particle_store.hpp"
 #include "millsim/sim/charge.hpp"
 
 namespace millsim {
@@ -56,8 +58,8 @@ struct MillResult {
   /// window, m from the mill axis. Its
   /// horizontal offset times the charge weight is the torque that holds the charge up.
   Vec2 charge_centre{};
-  /// Mean over the window and the balls of their angular speed about the mill axis divided by
-  /// the shell's: 1 when the charge rides with the shell (centrifuged).
+  /// The charge's angular speed about the mill axis (charge_motion) over the shell's, averaged
+  /// over the window: 1 when the charge rides with the shell (centrifuged).
   double orbital_speed_ratio = 0.0;
   /// The liner layer's balls by angle over the measured window, and from them the charge's toe
   /// and shoulder (ChargeProfile; sampled 50 times a revolution, with the charge's centre).
@@ -84,5 +86,16 @@ extern template MillResult run_mill<3>(const MillPlan&, World<3>, const std::fil
 /// Time for the shell to come up to speed (MillPlan::spin_up_time): a quarter of a revolution's
 /// period.
 double spin_up_time(const MillPlan& plan);
+
+/// The centre of mass of the particles in the cross-section (x, y), and their angular speed
+/// about the mill axis as a rigid body would have it: their angular momentum about the axis
+/// over their moment of inertia about it, Σ m (x × v) / Σ m |x|² (in the cross-section; the
+/// particles' own spins left out; 0 if all lie on the axis). That is the mean of each
+/// particle's angular speed (x × v) / |x|² weighted by m |x|², so that a ball passing near the
+/// axis, whose own angular speed can be anything, weighs next to nothing.
+template <int D>
+std::pair<Vec2, double> charge_motion(const ParticleStore<D>& particles);
+extern template std::pair<Vec2, double> charge_motion<2>(const ParticleStore<2>&);
+extern template std::pair<Vec2, double> charge_motion<3>(const ParticleStore<3>&);
 
 }  // namespace millsim
