@@ -184,8 +184,21 @@ void prepare_output_directory(const std::filesystem::path& out, const std::strin
     if (!made.empty()) std::filesystem::remove_all(made, ignored);
     throw refuse("write in", why);
   }
-  // Each result and its NAME.partial (what a killed run leaves) are removed: one that cannot be
-  // (a directory of that name, not empty) would only fail the write at the end of the run.
+  // Each result and its NAME.partial (what a killed run leaves) are removed. One that cannot be
+  // (a directory of that name, not empty) would only fail the write at the end of the run: it is
+  // refused first, before anything is removed, so that the earlier run's results stay whole.
+  for (const char* name : results) {
+    for (const std::string& file : {std::string(name), std::string(name) + ".partial"}) {
+      std::error_code error;
+      const std::filesystem::path path = out / file;
+      if (std::filesystem::symlink_status(path, error).type() ==
+              std::filesystem::file_type::directory &&
+          !std::filesystem::is_empty(path, error)) {
+        throw refuse("clear earlier results from",
+                     fmt::format("{}: a directory that is not empty", file));
+      }
+    }
+  }
   const auto clear = [&](const std::filesystem::path& path) {
     try {
       std::filesystem::remove(path);

@@ -492,15 +492,22 @@ TEST_F(Cli, AResultsPartialNameTakenByADirectoryIsRefusedBeforeTheRun) {
   // Results are written as NAME.partial and renamed. A directory of the user's (not empty)
   // named spectrum.csv.partial would fail that write at the end of the run, after the other
   // results were written: refused before the run starts, and left as it is.
+  // An earlier run's results in the directory are left whole too.
+  ASSERT_EQ(millsim(std::string("run mill.toml -o taken -q ") + tiny_run).status, 0);
+  const std::string earlier = read_all(work_ / "taken" / "summary.json");
   fs::create_directories(work_ / "taken" / "spectrum.csv.partial" / "mine");
   const Outcome taken = millsim(std::string("run mill.toml -o taken -q ") + tiny_run);
   EXPECT_EQ(taken.status, 2) << taken.err;
   EXPECT_NE(taken.err.find("command line (--out taken): output.directory: cannot clear earlier "
-                           "results from \"taken\" (spectrum.csv.partial: "),
+                           "results from \"taken\" (spectrum.csv.partial: a directory that is "
+                           "not empty)"),
             std::string::npos)
       << taken.err;
-  EXPECT_FALSE(fs::exists(work_ / "taken" / "summary.json"));
-  EXPECT_FALSE(fs::exists(work_ / "taken" / "power.csv"));
+  EXPECT_EQ(read_all(work_ / "taken" / "summary.json"), earlier);
+  for (const char* name :
+       {"power.csv", "power_timeseries.csv", "spectrum.csv", "charge_profile.csv", "impacts.csv"}) {
+    EXPECT_TRUE(fs::exists(work_ / "taken" / name)) << name;
+  }
   EXPECT_TRUE(fs::exists(work_ / "taken" / "spectrum.csv.partial" / "mine"));
 }
 
