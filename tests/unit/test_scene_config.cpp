@@ -247,6 +247,20 @@ TEST(SceneRun, WritesTrajectoryFinalAndSummaryAndNothingPartial) {
   EXPECT_NE(json.find("\"millsim_version\": \"" + millsim::version_text() + "\""),
             std::string::npos)
       << json;
+  EXPECT_NE(json.find("\"shortest_contact_duration_s\": "), std::string::npos) << json;
+  EXPECT_NE(json.find("\"critical_time_step_s\": "), std::string::npos) << json;
+
+  // A particle that can touch nothing (no wall, no other particle) has no contact duration and
+  // no stability limit: the summary leaves both out rather than write 0.
+  std::string alone(drop);
+  alone.erase(alone.find("[[walls]]"), alone.find("[materials") - alone.find("[[walls]]"));
+  std::ofstream(work / "alone.toml") << alone;
+  ASSERT_EQ(millsim_in(work, "run alone.toml -q --out alone"), 0);
+  std::ifstream alone_summary(work / "alone" / "summary.json");
+  const std::string alone_json((std::istreambuf_iterator<char>(alone_summary)), {});
+  EXPECT_EQ(alone_json.find("shortest_contact_duration_s"), std::string::npos) << alone_json;
+  EXPECT_EQ(alone_json.find("critical_time_step_s"), std::string::npos) << alone_json;
+  EXPECT_NE(alone_json.find("\"wall_count\": 0"), std::string::npos) << alone_json;
 
   // A refused scene writes nothing.
   std::string bad(drop);
@@ -256,6 +270,22 @@ TEST(SceneRun, WritesTrajectoryFinalAndSummaryAndNothingPartial) {
   EXPECT_FALSE(fs::exists(work / "refused"));
   std::error_code ignored;
   fs::remove_all(work, ignored);
+}
+
+TEST(SceneConfig, ATrajectoryIntervalAsLongAsTheRunOrLongerGivesOnlyStartAndEnd) {
+  // 10000 steps of 1e-6 s.
+  EXPECT_EQ(millsim::plan_scene(scene(drop)).trajectory_every, 10);
+  EXPECT_EQ(
+      millsim::plan_scene(scene(drop, {"output.trajectory_interval=0.00999"})).trajectory_every,
+      9990);
+  // As long as the run, or so long that its step count would not fit in a long (from about
+  // 9.2e18 steps; it once wrapped round to a row every step).
+  for (const std::string interval : {"0.01", "4.3e14", "1e300"}) {
+    EXPECT_EQ(millsim::plan_scene(scene(drop, {"output.trajectory_interval=" + interval}))
+                  .trajectory_every,
+              0)
+        << interval;
+  }
 }
 
 TEST(SceneConfig, RefusesSpeedsSizesAndPlacesBeyondAnyScene) {

@@ -114,8 +114,11 @@ std::string summary_json(const SceneResult& r) {
   add("particle_count", fmt::format("{}", c.particles.size()));
   add("wall_count", fmt::format("{}", c.walls.size()));
   add("time_step_s", number(r.plan.time_step));
-  add("critical_time_step_s", number(r.plan.critical_time_step));
-  add("shortest_contact_duration_s", number(r.plan.shortest_contact));
+  // A scene whose particles can touch nothing has neither (the plan holds 0 for them).
+  if (r.plan.shortest_contact > 0.0) {
+    add("critical_time_step_s", number(r.plan.critical_time_step));
+    add("shortest_contact_duration_s", number(r.plan.shortest_contact));
+  }
   add("steps", fmt::format("{}", r.steps));
   add("simulated_seconds", number(r.simulated_seconds));
   add("wall_seconds", number(r.wall_seconds));
@@ -195,9 +198,11 @@ ScenePlan plan_scene(const SceneConfig& config) {
   const double whole = std::round(exact);
   plan.steps =
       static_cast<long>(std::abs(exact - whole) <= 1e-9 * exact ? whole : std::ceil(exact));
-  if (config.trajectory_interval > 0.0) {
-    plan.trajectory_every =
-        std::max(1L, static_cast<long>(std::llround(config.trajectory_interval / plan.time_step)));
+  // An interval as long as the run or longer leaves no row between the start and the end (and
+  // would overflow a long as a step count from about 9e18 steps on).
+  const double interval_steps = config.trajectory_interval / plan.time_step;
+  if (config.trajectory_interval > 0.0 && interval_steps < static_cast<double>(plan.steps)) {
+    plan.trajectory_every = std::max(1L, static_cast<long>(std::llround(interval_steps)));
   }
   return plan;
 }
