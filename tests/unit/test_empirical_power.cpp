@@ -162,13 +162,31 @@ TEST(EmpiricalPower, ResultWarningsFlagAnOpenEnergyBalanceOrPowersThatDisagree) 
                 "power by torque (1 kW) and by dissipation (1.12 kW) differ by more than 10 %"),
             std::string::npos)
       << result_warnings(result)[0];
+  // The built-in example runs 6 revolutions and measures 4: the spin-up is not measured.
+  EXPECT_NE(result_warnings(result)[0].find("run more revolutions before measuring"),
+            std::string::npos)
+      << result_warnings(result)[0];
   result.power_dissipation_kw = 0.89;  // the other way round: 11 % of the larger
   EXPECT_EQ(result_warnings(result).size(), 1u);
+  MillResult measured_spin_up = result;
+  measured_spin_up.plan = plan_mill(
+      parse_mill_config(builtin_example_toml, "lab-mill-2d.toml",
+                        {"simulation.revolutions=2", "simulation.measure_revolutions=2"}));
+  ASSERT_EQ(result_warnings(measured_spin_up).size(), 1u);
+  EXPECT_NE(result_warnings(measured_spin_up)[0].find(
+                "the first revolution, which includes the spin-up, was measured; run more "
+                "revolutions than are measured"),
+            std::string::npos)
+      << result_warnings(measured_spin_up)[0];
   // An open balance explains the powers' disagreement: it alone is reported.
   result.energy_balance_error = 0.051;
   ASSERT_EQ(result_warnings(result).size(), 1u);
-  EXPECT_NE(result_warnings(result)[0].find("the energy balance is off by 0.051"),
-            std::string::npos)
+  EXPECT_NE(
+      result_warnings(result)[0].find("the energy balance is off by 5.1 % of the shell's work"),
+      std::string::npos)
+      << result_warnings(result)[0];
+  result.energy_balance_error = 21.2;
+  EXPECT_NE(result_warnings(result)[0].find("off by 2120 % of"), std::string::npos)
       << result_warnings(result)[0];
   result.energy_balance_error = std::nan("");
   EXPECT_EQ(result_warnings(result).size(), 1u);

@@ -321,20 +321,29 @@ void write_results(const std::filesystem::path& directory, const MillResult& res
 std::vector<std::string> result_warnings(const MillResult& r) {
   std::vector<std::string> warnings;
   if (!(r.energy_balance_error <= doubtful_energy_balance_error)) {
+    // Three digits, without an exponent from 100 % on (2120 %, not 2.12e+03 %).
+    const double error = 100.0 * r.energy_balance_error;
+    const std::string percent =
+        error >= 100.0 ? fmt::format("{:.0f}", error) : fmt::format("{:.3g}", error);
     warnings.push_back(fmt::format(
-        "the energy balance is off by {:.3g} of the shell's work (more than {:.0f} %): the time "
-        "step may be too coarse for these contacts, and the results are doubtful",
-        r.energy_balance_error, 100.0 * doubtful_energy_balance_error));
+        "the energy balance is off by {} % of the shell's work (more than {:.0f} %): the "
+        "time step may be too coarse for these contacts, and the results are doubtful",
+        percent, 100.0 * doubtful_energy_balance_error));
   }
   // A balance that does not close explains any disagreement of the two powers.
   const double larger = std::max(std::abs(r.power_kw), std::abs(r.power_dissipation_kw));
   if (warnings.empty() && larger > 0.0 &&
       std::abs(r.power_kw - r.power_dissipation_kw) > doubtful_power_disagreement * larger) {
+    const MillConfig& c = r.plan.config;
+    const bool spin_up_measured = c.measure_revolutions >= c.revolutions;
     warnings.push_back(fmt::format(
         "power by torque ({:.4g} kW) and by dissipation ({:.4g} kW) differ by more than {:.0f} %: "
-        "the charge was not steady over the measured revolutions (the first revolution includes "
-        "the spin-up; run more revolutions than are measured)",
-        r.power_kw, r.power_dissipation_kw, 100.0 * doubtful_power_disagreement));
+        "the charge was not steady over the measured revolutions ({})",
+        r.power_kw, r.power_dissipation_kw, 100.0 * doubtful_power_disagreement,
+        spin_up_measured ? "the first revolution, which includes the spin-up, was measured; run "
+                           "more revolutions than are measured"
+                         : "its energy changed over the window: run more revolutions before "
+                           "measuring, or measure more"));
   }
   return warnings;
 }
