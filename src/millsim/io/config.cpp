@@ -421,7 +421,8 @@ std::vector<SizeClass> graded_charge(double top_size) {
 
 std::string MillConfig::location_of(std::string_view dotted_key) const {
   const auto found = key_locations.find(dotted_key);
-  return found != key_locations.end() ? found->second : source;
+  // A key left at its default has no line: the message says so, lest the file be searched.
+  return found != key_locations.end() ? found->second : source + " (not given: its default)";
 }
 
 namespace {

@@ -75,8 +75,9 @@ struct MillConfig {
   std::map<std::string, std::string, std::less<>> key_locations;
 
   /// Where `dotted_key` was given, for a message about it found after reading (an unstable
-  /// time step, a charge that does not fit): as in key_locations, or `source` for a key left
-  /// at its default. Use as "{location_of(key)}: {key}: message; allowed: ...".
+  /// time step, a charge that does not fit): as in key_locations, or "`source` (not given: its
+  /// default)" for a key left at its default. Use as "{location_of(key)}: {key}: message;
+  /// allowed: ...".
   std::string location_of(std::string_view dotted_key) const;
 };
 
@@ -115,7 +116,7 @@ struct SceneConfig {
 
   // [output]
   std::string output_directory = "out";
-  double trajectory_interval = 0.0;  ///< s; 0 = no trajectory.csv
+  double trajectory_interval = 0.0;  ///< s; 0: trajectory rows at the start and end only
 
   std::map<std::string, std::string, std::less<>> key_locations;
   std::string location_of(std::string_view dotted_key) const;

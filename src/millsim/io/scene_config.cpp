@@ -274,7 +274,8 @@ SceneConfig read_scene_config(const toml::table& document, const std::string& so
 
 std::string SceneConfig::location_of(std::string_view dotted_key) const {
   const auto found = key_locations.find(dotted_key);
-  return found != key_locations.end() ? found->second : source;
+  // A key left at its default has no line: the message says so, lest the file be searched.
+  return found != key_locations.end() ? found->second : source + " (not given: its default)";
 }
 
 }  // namespace millsim

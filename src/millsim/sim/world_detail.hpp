@@ -30,8 +30,9 @@ inline ContactType wall_contact_type(WallKind kind) {
 /// Blocks of pairs and of wall candidates are the unit of parallel work and of partial sums.
 /// Their sizes are chosen at each rebuild from the list alone (block_size_for), never from
 /// the number of threads, so that results do not depend on it: a sixteenth of the pairs and a
-/// quarter of the candidates, rounded up to a power of two within 256–1024 pairs or 64–256
-/// candidates (so at most 16 and 4 blocks where the size is not at its largest). Large
+/// quarter of the candidates (whole numbers, rounded down), rounded up to a power of two within
+/// 256–1024 pairs or 64–256 candidates (so at most 17 and 5 blocks where the size is not at its
+/// largest: 4 097 pairs make 17 blocks of 256). Large
 /// blocks cost less per pair (the 2D SAG scene, 941 candidates, was 0.7 % slower on two threads
 /// in 8 blocks of 128 than in 4 of 256); in a small world, where one block was a third of the
 /// list, the blocks that two threads' runs share (done one pair at a time, or by one thread for
