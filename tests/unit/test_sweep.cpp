@@ -62,8 +62,15 @@ TEST(Sweep, AListSplitsOnlyBetweenValues) {
                     "0.5}]"}));
   EXPECT_EQ(parse_vary("reference.case=\"a,b:c\", 'd,e', \"f\\\",g\"").values,
             (Values{"\"a,b:c\"", "'d,e'", "\"f\\\",g\""}));
-  // An unclosed string or bracket keeps the rest whole; the TOML reader refuses it later.
+  // Multi-line strings hold single quotes; a bracket inside a string in an array is text.
+  EXPECT_EQ(parse_vary(R"(reference.case="""a"b,c""",'''a'b,c''',["a]", 1],2)").values,
+            (Values{R"("""a"b,c""")", "'''a'b,c'''", R"(["a]", 1])", "2"}));
+  // A quote or bracket inside plain text opens nothing (TOML's open only a value).
+  EXPECT_EQ(parse_vary("reference.case=it's,b, a[1 ,c").values, (Values{"it's", "b", "a[1", "c"}));
+  // An unclosed string or bracket at the start of a value keeps the rest whole; the TOML
+  // reader refuses it later where its key takes a number.
   EXPECT_EQ(parse_vary("charge.sizes=[0.1, 0.2").values, (Values{"[0.1, 0.2"}));
+  EXPECT_EQ(parse_vary("reference.case=\"a, b").values, (Values{"\"a, b"}));
   // A colon outside them still makes a range.
   EXPECT_EQ(parse_vary("mill.speed=0.5:0.7:0.1").values, (Values{"0.5", "0.6", "0.7"}));
 }

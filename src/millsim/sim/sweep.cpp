@@ -55,31 +55,41 @@ std::optional<double> read_number(std::string_view text) {
   return value;
 }
 
-/// Where `separator` occurs in `text` outside TOML strings ("...", '...') and outside brackets
-/// and braces, so that a value such as "a,b" or [{diameter = 0.1, mass_fraction = 1}] stays
-/// whole. An unclosed string or bracket runs to the end: the value is then refused by the TOML
-/// reader, with its key, as --set's would be.
+/// Where `separator` occurs in `text` outside TOML strings and outside arrays and inline
+/// tables, so that a value such as "a,b" or [{diameter = 0.1, mass_fraction = 1}] stays whole.
+/// At the top level a quote or bracket opens a string or array only as the first character of
+/// a value, as in TOML: in plain text (it's, a[1) it is a character like any other, and the
+/// comma after it still ends the value. Strings are basic ("...", with \ escapes), literal
+/// ('...') or multi-line (""" or '''). An unclosed one runs to the end of the text: the value is
+/// then read as --set reads it (refused if its key takes a number; text if it takes text).
 std::vector<std::size_t> top_level_positions(std::string_view text, char separator) {
   std::vector<std::size_t> positions;
   int depth = 0;
-  char quote = 0;
-  for (std::size_t i = 0; i < text.size(); ++i) {
+  std::size_t value_start = 0;
+  for (std::size_t i = 0; i < text.size();) {
     const char c = text[i];
-    if (quote != 0) {
-      if (quote == '"' && c == '\\') {
-        ++i;  // an escape: the next character is not the closing quote
-      } else if (c == quote) {
-        quote = 0;
+    const bool opens_here =
+        depth > 0 || text.substr(value_start, i - value_start).find_first_not_of(" \t") ==
+                         std::string_view::npos;
+    if (opens_here && (c == '"' || c == '\'')) {
+      const std::size_t quotes = text.substr(i, 3) == std::string(3, c) ? 3 : 1;
+      const std::string_view closing = text.substr(i, quotes);
+      std::size_t j = i + quotes;
+      while (j < text.size() && text.substr(j, quotes) != closing) {
+        j += c == '"' && text[j] == '\\' ? 2 : 1;  // an escape: the next character is not a quote
       }
-    } else if (c == '"' || c == '\'') {
-      quote = c;
-    } else if (c == '[' || c == '{') {
-      ++depth;
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    } else if (c == separator && depth == 0) {
-      positions.push_back(i);
+      i = std::min(text.size(), j + quotes);
+      continue;
     }
+    if (opens_here && (c == '[' || c == '{')) {
+      ++depth;
+    } else if (depth > 0 && (c == ']' || c == '}')) {
+      --depth;
+    } else if (depth == 0 && c == separator) {
+      positions.push_back(i);
+      value_start = i + 1;
+    }
+    ++i;
   }
   return positions;
 }
