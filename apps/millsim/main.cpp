@@ -2,16 +2,13 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <omp.h>
-#include <stdlib.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <initializer_list>
@@ -33,12 +30,16 @@
 #include "millsim/sim/mill_run.hpp"
 #include "millsim/sim/scene_run.hpp"
 #include "millsim/sim/sweep.hpp"
+#include "output_directory.hpp"
 
 namespace {
 
 using millsim::MillConfig;
 using millsim::MillPlan;
 using millsim::MillResult;
+using millsim_app::prepare_output_directory;
+using millsim_app::refuse_a_file_as_directory;
+using millsim_app::Snapshots;
 
 struct JobOptions {
   std::string config_path;  // empty: the built-in example
@@ -102,124 +103,6 @@ class ProgressLine {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-/// Refuses an output directory `out` that exists as something other than a directory;
-/// `location` names where it was given.
-void refuse_a_file_as_directory(const std::filesystem::path& out, const std::string& location) {
-  // The non-throwing status: a path the system cannot look up (a name too long) is refused here
-  // with the key, not reported as a failed run. (One below a file reads as not found, and
-  // creating it fails below.)
-  std::error_code error;
-  const std::filesystem::file_status state = std::filesystem::status(out, error);
-  if (error && state.type() != std::filesystem::file_type::not_found) {
-    throw millsim::InputError(
-        fmt::format("{}: output.directory: cannot use \"{}\" ({}); allowed: a directory that "
-                    "can be created and written",
-                    location, out.string(), error.message()));
-  }
-  if (std::filesystem::exists(state) && !std::filesystem::is_directory(state)) {
-    throw millsim::InputError(
-        fmt::format("{}: output.directory: \"{}\" exists and is not a directory; allowed: a "
-                    "directory path",
-                    location, out.string()));
-  }
-}
-
-/// What becomes of an earlier run's snapshots/ subdirectory: left (scenes write none), removed,
-/// or removed and made again empty.
-enum class Snapshots { untouched, removed, made };
-
-/// Creates the output directory `out`, checks that a file can be written in it, and removes the
-/// `results`, their NAME.partial files (and snapshots/, for a mill) an earlier run left in it, so
-/// that a run stopped half-way leaves no mixture of two runs' files. Called before the
-/// simulation, so that a directory that cannot take the results is refused before any time is
-/// spent. `location` names where the
-/// directory was given (config line, --set or --out) for the message if it cannot be used.
-void prepare_output_directory(const std::filesystem::path& out, const std::string& location,
-                              std::initializer_list<const char*> results,
-                              Snapshots snapshots = Snapshots::untouched) {
-  const auto refuse = [&](const std::string& what, const std::string& why) {
-    return millsim::InputError(
-        fmt::format("{}: output.directory: cannot {} \"{}\" ({}); allowed: a directory that "
-                    "can be created and written",
-                    location, what, out.string(), why));
-  };
-  refuse_a_file_as_directory(out, location);
-  // The first of its parents that does not exist yet: what this call makes, and removes again
-  // if the directory turns out to take no files. Anything whose state cannot be read (or a
-  // link, even a dangling one) counts as existing: only what is surely absent is ever removed.
-  std::filesystem::path made;
-  for (std::filesystem::path p = out; !p.empty(); p = p.parent_path()) {
-    std::error_code error;
-    const std::filesystem::file_status state = std::filesystem::symlink_status(p, error);
-    // (A missing path sets `error` too, with the type not_found; any other error leaves the
-    // type none.)
-    if (state.type() != std::filesystem::file_type::not_found) break;
-    made = p;
-    if (p == p.parent_path()) break;
-  }
-  try {
-    std::filesystem::create_directories(out);
-  } catch (const std::filesystem::filesystem_error& error) {
-    throw refuse("make", error.code().message());
-  }
-  // A file of its own (mkstemp: no file of the user's is touched) written and removed: a
-  // directory that exists but takes no files (read-only, full, immutable) is found now, not
-  // when the results are written at the end.
-  std::string probe = (out / ".millsim-write-check-XXXXXX").string();
-  const int descriptor = ::mkstemp(probe.data());
-  bool writes = false;
-  std::string why;
-  if (descriptor < 0) {
-    why = std::strerror(errno);
-  } else {
-    std::FILE* file = ::fdopen(descriptor, "w");
-    writes = file != nullptr && std::fputs("millsim\n", file) >= 0;
-    writes = (file != nullptr ? std::fclose(file) == 0 : ::close(descriptor) == 0) && writes;
-    std::error_code ignored;
-    std::filesystem::remove(probe, ignored);
-    if (!writes) why = "a test file could not be written";
-  }
-  if (!writes) {
-    std::error_code ignored;
-    if (!made.empty()) std::filesystem::remove_all(made, ignored);
-    throw refuse("write in", why);
-  }
-  // Each result and its NAME.partial (what a killed run leaves) are removed. One that cannot be
-  // (a directory of that name, not empty) would only fail the write at the end of the run: it is
-  // refused first, before anything is removed, so that the earlier run's results stay whole.
-  for (const char* name : results) {
-    for (const std::string& file : {std::string(name), std::string(name) + ".partial"}) {
-      std::error_code error;
-      const std::filesystem::path path = out / file;
-      if (std::filesystem::symlink_status(path, error).type() ==
-              std::filesystem::file_type::directory &&
-          !std::filesystem::is_empty(path, error)) {
-        throw refuse("clear earlier results from",
-                     fmt::format("{}: a directory that is not empty", file));
-      }
-    }
-  }
-  const auto clear = [&](const std::filesystem::path& path) {
-    try {
-      std::filesystem::remove(path);
-    } catch (const std::filesystem::filesystem_error& error) {
-      throw refuse("clear earlier results from",
-                   fmt::format("{}: {}", path.filename().string(), error.code().message()));
-    }
-  };
-  for (const char* name : results) {
-    clear(out / name);
-    clear(out / (std::string(name) + ".partial"));
-  }
-  try {
-    if (snapshots != Snapshots::untouched) std::filesystem::remove_all(out / "snapshots");
-    if (snapshots == Snapshots::made) std::filesystem::create_directories(out / "snapshots");
-  } catch (const std::filesystem::filesystem_error& error) {
-    throw refuse("clear earlier results from",
-                 fmt::format("snapshots: {}", error.code().message()));
-  }
-}
-
 /// Where the output directory was given: --out, or the config's key (or --set).
 template <typename Config>
 std::string output_location(const Config& config, const JobOptions& options) {
@@ -247,11 +130,13 @@ MillResult run_job(const MillPlan& plan, const std::string& out_location, bool s
   const MillConfig& config = plan.config;
   millsim::World<D> world = millsim::build_mill_world<D>(plan);
   const std::filesystem::path out = config.output_directory;
-  prepare_output_directory(out, out_location,
-                           {"summary.json", "power.csv", "power_timeseries.csv", "spectrum.csv",
-                            "charge_profile.csv", "impacts.csv"},
-                           config.snapshot_interval > 0.0 ? Snapshots::made : Snapshots::removed);
+  const std::vector<std::string> cleared = prepare_output_directory(
+      out, out_location,
+      {"summary.json", "power.csv", "power_timeseries.csv", "spectrum.csv", "charge_profile.csv",
+       "impacts.csv"},
+      config.snapshot_interval > 0.0 ? Snapshots::made : Snapshots::removed);
   if (started) started();
+  warn(cleared);
   warn(plan.warnings);
   const std::filesystem::path snapshots = out / "snapshots";
   ProgressLine progress(show_progress);
@@ -274,9 +159,10 @@ MillResult run_job(const MillConfig& config, const std::string& out_location, bo
 int run_scene_command(const millsim::SceneConfig& scene, const JobOptions& options) {
   const millsim::ScenePlan plan = millsim::plan_scene(scene);
   const std::filesystem::path out = scene.output_directory;
-  prepare_output_directory(out, output_location(scene, options),
-                           {"summary.json", "trajectory.csv", "final.csv"});
+  const std::vector<std::string> cleared = prepare_output_directory(
+      out, output_location(scene, options), {"summary.json", "trajectory.csv", "final.csv"});
   if (!options.quiet) fmt::print("millsim: running scene {}\n", scene.source);
+  warn(cleared);
   warn(plan.warnings);
   ProgressLine progress(!options.quiet);
   const millsim::SceneResult result = millsim::run_scene(
@@ -624,11 +510,11 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
                parallel ? fmt::format("{} at a time", threads) : std::string("one at a time"));
     std::fflush(stdout);
   }
-  prepare_output_directory(root,
-                           options.output_directory.empty()
-                               ? std::string("the default output directory")
-                               : fmt::format("command line (--out {})", root.string()),
-                           {"sweep.csv"});
+  warn(prepare_output_directory(root,
+                                options.output_directory.empty()
+                                    ? std::string("the default output directory")
+                                    : fmt::format("command line (--out {})", root.string()),
+                                {"sweep.csv"}));
   const std::vector<millsim::SweepRow> rows =
       run_sweep(plans, axes, points, options.quiet, parallel);
   millsim::write_sweep_csv(root / "sweep.csv", axes, rows);

@@ -485,6 +485,21 @@ TEST_F(Cli, ARunRemovesTheResultsAnEarlierRunLeftInItsDirectory) {
   EXPECT_NE(read_all(work_ / "out" / "power.csv"), "stale\n");
   EXPECT_NE(read_all(work_ / "out" / "charge_profile.csv"), "stale\n");
   EXPECT_EQ(read_all(work_ / "out" / "notes.txt"), "stale\n");
+
+  // A killed run's .partial file and snapshots go too (this run writes no snapshots), and the
+  // directory they were moved aside to before removal is gone.
+  std::ofstream(work_ / "out" / "impacts.csv.partial") << "half\n";
+  fs::create_directories(work_ / "out" / "snapshots" / "deep");
+  std::ofstream(work_ / "out" / "snapshots" / "deep" / "snapshot_000000.csv") << "stale\n";
+  ASSERT_EQ(millsim(std::string("run mill.toml -o out -q ") + tiny_run).status, 0);
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(work_ / "out")) {
+    left.push_back(entry.path().filename().string());
+  }
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left,
+            (std::vector<std::string>{"charge_profile.csv", "impacts.csv", "notes.txt", "power.csv",
+                                      "power_timeseries.csv", "spectrum.csv", "summary.json"}));
 }
 
 TEST_F(Cli, AResultsPartialNameTakenByADirectoryIsRefusedBeforeTheRun) {
@@ -498,9 +513,11 @@ TEST_F(Cli, AResultsPartialNameTakenByADirectoryIsRefusedBeforeTheRun) {
   fs::create_directories(work_ / "taken" / "spectrum.csv.partial" / "mine");
   const Outcome taken = millsim(std::string("run mill.toml -o taken -q ") + tiny_run);
   EXPECT_EQ(taken.status, 2) << taken.err;
-  EXPECT_NE(taken.err.find("command line (--out taken): output.directory: cannot clear earlier "
-                           "results from \"taken\" (spectrum.csv.partial: a directory that is "
-                           "not empty)"),
+  EXPECT_NE(taken.err.find("command line (--out taken): output.directory: \"taken\" holds a "
+                           "directory spectrum.csv.partial where the run writes a result (not "
+                           "empty); allowed: an output directory where no result's name is taken "
+                           "(remove or rename taken/spectrum.csv.partial, or choose another "
+                           "directory)"),
             std::string::npos)
       << taken.err;
   EXPECT_EQ(read_all(work_ / "taken" / "summary.json"), earlier);

@@ -1,0 +1,168 @@
+#include "output_directory.hpp"
+
+#include <fmt/format.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <system_error>
+
+#include "millsim/core/error.hpp"
+
+namespace millsim_app {
+
+namespace fs = std::filesystem;
+
+void refuse_a_file_as_directory(const fs::path& out, const std::string& location) {
+  // The non-throwing status: a path the system cannot look up (a name too long) is refused here
+  // with the key, not reported as a failed run. (One below a file reads as not found, and
+  // creating it fails below.)
+  std::error_code error;
+  const fs::file_status state = fs::status(out, error);
+  if (error && state.type() != fs::file_type::not_found) {
+    throw millsim::InputError(
+        fmt::format("{}: output.directory: cannot use \"{}\" ({}); allowed: a directory that "
+                    "can be created and written",
+                    location, out.string(), error.message()));
+  }
+  if (fs::exists(state) && !fs::is_directory(state)) {
+    throw millsim::InputError(
+        fmt::format("{}: output.directory: \"{}\" exists and is not a directory; allowed: a "
+                    "directory path",
+                    location, out.string()));
+  }
+}
+
+namespace {
+
+/// Makes `out` (and its missing parents) and writes and removes a file of its own in it, so
+/// that a directory that exists but takes no files (read-only, full, immutable) is found now,
+/// not when the results are written at the end. What it made is removed again if it fails.
+void make_and_check_writable(const fs::path& out, const std::string& location) {
+  const auto refuse = [&](const std::string& what, const std::string& why) {
+    return millsim::InputError(
+        fmt::format("{}: output.directory: cannot {} \"{}\" ({}); allowed: a directory that "
+                    "can be created and written",
+                    location, what, out.string(), why));
+  };
+  // The first of its parents that does not exist yet: what this call makes, and removes again
+  // if the directory turns out to take no files. Anything whose state cannot be read (or a
+  // link, even a dangling one) counts as existing: only what is surely absent is ever removed.
+  fs::path made;
+  for (fs::path p = out; !p.empty(); p = p.parent_path()) {
+    std::error_code error;
+    const fs::file_status state = fs::symlink_status(p, error);
+    // (A missing path sets `error` too, with the type not_found; any other error leaves the
+    // type none.)
+    if (state.type() != fs::file_type::not_found) break;
+    made = p;
+    if (p == p.parent_path()) break;
+  }
+  try {
+    fs::create_directories(out);
+  } catch (const fs::filesystem_error& error) {
+    throw refuse("make", error.code().message());
+  }
+  // mkstemp: no file of the user's is touched.
+  std::string probe = (out / ".millsim-write-check-XXXXXX").string();
+  const int descriptor = ::mkstemp(probe.data());
+  bool writes = false;
+  std::string why;
+  if (descriptor < 0) {
+    why = std::strerror(errno);
+  } else {
+    std::FILE* file = ::fdopen(descriptor, "w");
+    writes = file != nullptr && std::fputs("millsim\n", file) >= 0;
+    writes = (file != nullptr ? std::fclose(file) == 0 : ::close(descriptor) == 0) && writes;
+    std::error_code ignored;
+    fs::remove(probe, ignored);
+    if (!writes) why = "a test file could not be written";
+  }
+  if (!writes) {
+    std::error_code ignored;
+    if (!made.empty()) fs::remove_all(made, ignored);
+    throw refuse("write in", why);
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> prepare_output_directory(const fs::path& out, const std::string& location,
+                                                  std::initializer_list<const char*> results,
+                                                  Snapshots snapshots) {
+  refuse_a_file_as_directory(out, location);
+  make_and_check_writable(out, location);
+  std::vector<std::string> names;
+  for (const char* name : results) {
+    names.emplace_back(name);
+    names.push_back(std::string(name) + ".partial");
+  }
+  // A directory under a result's name (not snapshots/, which is ours) is the user's: the run
+  // would fail to write the result there at its end. Refused before anything moves.
+  for (const std::string& name : names) {
+    std::error_code error;
+    if (fs::symlink_status(out / name, error).type() != fs::file_type::directory) continue;
+    const bool empty = fs::is_empty(out / name, error);
+    if (error || !empty) {
+      throw millsim::InputError(fmt::format(
+          "{}: output.directory: \"{}\" holds a directory {} where the run writes a result "
+          "({}); allowed: an output directory where no result's name is taken (remove or "
+          "rename {}, or choose another directory)",
+          location, out.string(), name, error ? error.message() : "not empty",
+          (out / name).string()));
+    }
+  }
+  if (snapshots != Snapshots::untouched) names.emplace_back("snapshots");
+
+  // The earlier results are renamed into a directory of their own in `out`, so that if one
+  // cannot be, those moved are put back and the refusal loses nothing; then it is removed.
+  std::string aside = (out / ".millsim-earlier-results-XXXXXX").string();
+  if (::mkdtemp(aside.data()) == nullptr) {
+    throw millsim::InputError(fmt::format(
+        "{}: output.directory: cannot clear earlier results from \"{}\" ({}); allowed: a "
+        "directory that can be created and written",
+        location, out.string(), std::strerror(errno)));
+  }
+  std::vector<std::string> moved;
+  for (const std::string& name : names) {
+    std::error_code error;
+    if (fs::symlink_status(out / name, error).type() == fs::file_type::not_found) continue;
+    fs::rename(out / name, fs::path(aside) / name, error);
+    if (error) {
+      std::error_code ignored;
+      for (auto back = moved.rbegin(); back != moved.rend(); ++back) {
+        fs::rename(fs::path(aside) / *back, out / *back, ignored);
+      }
+      fs::remove(aside, ignored);  // only if it is empty again
+      throw millsim::InputError(fmt::format(
+          "{}: output.directory: cannot clear earlier results from \"{}\" ({}: {}); allowed: a "
+          "directory whose earlier results can be removed",
+          location, out.string(), name, error.message()));
+    }
+    moved.push_back(name);
+  }
+  std::vector<std::string> warnings;
+  std::error_code error;
+  fs::remove_all(aside, error);
+  if (error) {
+    warnings.push_back(fmt::format(
+        "an earlier run's results were moved aside to {}/ but could not all be removed ({}): "
+        "remove that directory yourself",
+        aside, error.message()));
+  }
+  if (snapshots == Snapshots::made) {
+    try {
+      fs::create_directories(out / "snapshots");
+    } catch (const fs::filesystem_error& failure) {
+      throw millsim::InputError(fmt::format(
+          "{}: output.directory: cannot make \"{}\" ({}); allowed: a directory that can be "
+          "created and written",
+          location, (out / "snapshots").string(), failure.code().message()));
+    }
+  }
+  return warnings;
+}
+
+}  // namespace millsim_app

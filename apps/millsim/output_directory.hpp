@@ -1,0 +1,34 @@
+// The output directory of a run: made, checked to take files, and cleared of an earlier run's
+// results, all before the run starts, so that a directory that cannot take the results is
+// refused (exit 2) before any time is spent and a run stopped half-way never leaves a mixture
+// of two runs' files.
+#pragma once
+
+#include <filesystem>
+#include <initializer_list>
+#include <string>
+#include <vector>
+
+namespace millsim_app {
+
+/// Refuses (InputError) an output directory `out` that exists as something other than a
+/// directory, or whose state cannot be read; `location` names where it was given.
+void refuse_a_file_as_directory(const std::filesystem::path& out, const std::string& location);
+
+/// What becomes of an earlier run's snapshots/ subdirectory: left (scenes write none), removed,
+/// or removed and made again empty.
+enum class Snapshots { untouched, removed, made };
+
+/// Creates `out`, checks that a file can be written in it, and clears the `results`, their
+/// NAME.partial files (what a killed run leaves) and, unless untouched, snapshots/ that an
+/// earlier run left in it. A result's name taken by a directory of the user's (not empty) is
+/// refused before anything moves. The rest are moved aside with renames in `out` (put back if
+/// one fails, so that a refusal loses nothing), then removed. Returns warnings for the run to
+/// print (what could be moved aside but not removed). Throws InputError naming `location`
+/// (config line, --set or --out) if the directory cannot be used.
+std::vector<std::string> prepare_output_directory(const std::filesystem::path& out,
+                                                  const std::string& location,
+                                                  std::initializer_list<const char*> results,
+                                                  Snapshots snapshots = Snapshots::untouched);
+
+}  // namespace millsim_app
