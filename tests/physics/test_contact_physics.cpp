@@ -186,8 +186,10 @@ TEST(ContactHeadOn, DiscDiscWithoutTensionFollowsTheNoTensionOscillator) {
       record(case_name("expected_restitution", e, masses), expected.restitution);
       record(case_name("force_duration_over_t_star", e, masses),
              measured.force_duration / expected.duration);
-      EXPECT_NEAR(measured.restitution, expected.restitution, 0.01 * expected.restitution);
-      EXPECT_NEAR(measured.force_duration, expected.duration, 0.02 * expected.duration);
+      EXPECT_NEAR(measured.restitution, expected.restitution,
+                  no_tension_restitution_tolerance * expected.restitution);
+      EXPECT_NEAR(measured.force_duration, expected.duration,
+                  no_tension_duration_tolerance * expected.duration);
       record(case_name("energy_balance", e, masses), measured.energy_balance);
       EXPECT_NEAR(measured.energy_balance, 0.0, energy_balance_tolerance);
     }
@@ -226,8 +228,10 @@ TEST(ContactHeadOn, DiscWallWithoutTensionFollowsTheNoTensionOscillator) {
     record(fmt::format("expected_restitution_e{}", e), expected.restitution);
     record(fmt::format("force_duration_over_t_star_e{}", e),
            measured.force_duration / expected.duration);
-    EXPECT_NEAR(measured.restitution, expected.restitution, 0.01 * expected.restitution);
-    EXPECT_NEAR(measured.force_duration, expected.duration, 0.02 * expected.duration);
+    EXPECT_NEAR(measured.restitution, expected.restitution,
+                no_tension_restitution_tolerance * expected.restitution);
+    EXPECT_NEAR(measured.force_duration, expected.duration,
+                no_tension_duration_tolerance * expected.duration);
     record(fmt::format("energy_balance_e{}", e), measured.energy_balance);
     EXPECT_NEAR(measured.energy_balance, 0.0, energy_balance_tolerance);
   }
@@ -461,7 +465,8 @@ TEST(ObliqueImpact2D, ElasticDiscsStickOrSlideAsTheClosedFormSays) {
       ASSERT_GE(t, 6.0 * mu);
       ++sliding;
       const double expected = 1.0 - 2.0 * mu * vn / vt;
-      EXPECT_NEAR(tangential_restitution, expected, 0.01 * expected);
+      // On the friction's share, 1 − the ratio (the ratio itself is mostly the 1).
+      EXPECT_NEAR(1.0 - tangential_restitution, 1.0 - expected, 0.01 * (1.0 - expected));
       const double expected_spin = -4.0 * mu * vn / disc_radius;
       EXPECT_NEAR(spin, expected_spin, 0.01 * std::abs(expected_spin));
     }

@@ -181,6 +181,10 @@ void expect_impact(const std::string& name, const ImpactAnswer& expected,
     EXPECT_NEAR(measured.restitution, expected.restitution,
                 second_order_tolerance * expected.restitution);
     EXPECT_NEAR(duration, expected.duration, second_order_tolerance * expected.duration);
+  } else {
+    EXPECT_NEAR(measured.restitution, expected.restitution,
+                no_tension_restitution_tolerance * expected.restitution);
+    EXPECT_NEAR(duration, expected.duration, no_tension_duration_tolerance * expected.duration);
   }
   EXPECT_NEAR(measured.energy_balance, 0.0, energy_balance_tolerance);
   EXPECT_LT(measured.largest_tangential_over_normal, spurious_tangential_tolerance);
@@ -432,7 +436,10 @@ TEST(ObliqueImpact3D, SphereOnPlaneInGrossSlidingFollowsTheCoulombImpulse) {
     record("expected_tangential_restitution_" + name, expected_tangential);
     record("spin_over_expected_" + name, spin / expected_spin);
     record("energy_balance_" + name, measured.impact.energy_balance);
-    EXPECT_NEAR(measured.tangential_restitution, expected_tangential, 0.02 * expected_tangential);
+    // The tolerance is on the friction's part, 1 − the tangential restitution, not on the
+    // ratio, which is mostly the 1: 2 % of the ratio could hide a good part of the friction's.
+    EXPECT_NEAR(1.0 - measured.tangential_restitution, 1.0 - expected_tangential,
+                0.02 * (1.0 - expected_tangential));
     EXPECT_NEAR(spin, expected_spin, 0.02 * expected_spin);
     // Nothing leaves the plane of incidence: no velocity along b, no spin about n or t.
     EXPECT_LT(std::abs(dot(measured.velocity, plane_binormal)), 1e-9 * oblique_speed);
