@@ -3,7 +3,8 @@
 // one restarts at the overlap of the break, the tangential one at zero), and the energy they
 // held is booked as dissipated. A contact is driven through the law: two steps of loading build
 // both springs, a third pulls the bodies apart fast enough that the dashpot beats the spring
-// while they overlap, a fourth pushes them together again.
+// while they overlap, a fourth pushes them together again. Then one slipping step, worked by
+// hand: Coulomb's cap on the total normal force, and the energy the step books.
 // 2D and 3D have their own code (evaluate_2d, evaluate_3d) up to the break, which both hand to
 // the one conclude(); Lanes run that same code (ContactLanes checks they give each lane the bits
 // of one double), so the doubles here pin the break for the lanes too.
@@ -120,6 +121,41 @@ TEST(ContactBreak, PulledApartWhileOverlappingForgetsBothSpringsAndBooksTheirEne
 
 TEST(ContactBreak, PulledApartWhileOverlappingForgetsBothSpringsAndBooksTheirEnergySpheres) {
   check_break_forgets_both_springs<3>();
+}
+
+/// One slipping step worked by hand (MODEL.md §3, "Friction", and docs/model.md): the cap is μ
+/// times the total normal force, spring and dashpot, the tangential force points along the
+/// trial force, the spring is set to it, and the step books the dashpot's work and the slip's.
+template <int D>
+void check_slipping_step() {
+  const LinearSpringDashpot law(
+      ContactMaterial{normal_stiffness, tangential_stiffness, 0.5, friction});
+  const Vec<D> n = axis<D>(0);
+  const Vec<D> y = axis<D>(1);
+  ContactHistory<D> history;
+  // First step of contact: overlap 5 × 10⁻⁵ m, approaching at 5 m/s, sliding at 100 m/s along y.
+  // Normal: spring k_n δ = 50 N, dashpot c_n × 5 = 200 N, total 250 N. Tangential: the spring
+  // grows by −k_s v_s Δt = −8e5 × 100 × 1e-5 = −800 N, the trial force −800 − c_s × 100 =
+  // −900 N, beyond μ × 250 = 125 N: it slips, at −125 N along y. (Capped at μ times the spring
+  // alone it would be 25 N.)
+  const double sliding = 100.0;
+  const ContactOutput<D> out =
+      law.evaluate(moving<D>(5e-5, -speed, sliding), damping, history, time_step);
+  expect_close(out.force, 250.0 * n - 125.0 * y);
+  expect_close(out.tangential_force, -125.0 * y);
+  expect_close(tangential_spring_force(history), -125.0 * y);
+  // The normal dashpot's c_n v_n² Δt = 40 × 25 × 1e-5 = 0.01 J; the slip's −F_t·v_s Δt less what
+  // the spring took up: 125 × 100 × 1e-5 − 125² / (2 × 8e5) = 0.125 − 0.009765625 J.
+  expect_close(out.dissipated, 0.01 + 0.125 - 0.009765625);
+  expect_close(history.dissipated, 0.01 + 0.125 - 0.009765625);
+}
+
+TEST(ContactSlip, ASlippingStepIsCappedAtMuTimesTheTotalNormalForceDiscs) {
+  check_slipping_step<2>();
+}
+
+TEST(ContactSlip, ASlippingStepIsCappedAtMuTimesTheTotalNormalForceSpheres) {
+  check_slipping_step<3>();
 }
 
 }  // namespace
