@@ -341,6 +341,51 @@ TEST(LeapfrogStability, BoundedJustBelowTheLimitAndGrowingJustAboveIt) {
   EXPECT_GT(largest_offset_between_walls(1.02, 100), 1e3);
 }
 
+// The tangential limit, which binds when k_s / m_t > k_n / m*: a disc resting on the floor under
+// gravity, sticking (μ = 10), no damping (e = 1). Its contact point's slip oscillates with
+// ω² = k_s / m_t, m_t = m / 3 (the disc's mass and inertia r²/I = 2/m acting together:
+// tangential_mass), while it rolls on at constant speed; k_s = k_n makes that ω √3 times the
+// normal one, so the library's limit is the tangential 2/ω. Started with the slip speed ε (the
+// disc sliding, not turning), the slip speed v_x + ω r stays within the leapfrog's invariant
+// bound below the limit and grows by |λ| a step above it.
+double largest_slip_speed_on_floor(double limit_fraction, int steps) {
+  const double radius = 0.05, mass = 2.0, nudge = 1e-6;
+  const ContactMaterial material{1.0e6, 1.0e6, 1.0, 10.0};
+  WorldSettings<2> settings;
+  settings.time_step =
+      limit_fraction * critical_time_step(material, mass, tangential_mass(mass, 0.0, 0.5));
+  settings.gravity = Vec2{{0.0, -standard_gravity}};
+  settings.ball_wall = material;
+  Walls<2> walls;
+  walls.planes.push_back(Plane<2>{Vec2{{0.0, 0.0}}, Vec2{{0.0, 1.0}}});
+  World<2> world(settings, walls);
+  // At the overlap where the spring carries the weight, m g / k_n.
+  const double rest = radius - mass * standard_gravity / material.normal_stiffness;
+  world.particles().add(Vec2{{0.0, rest}}, radius, mass, Vec2{{nudge, 0.0}});
+  double largest = 0.0;
+  for (int n = 0; n < steps; ++n) {
+    world.step();
+    const auto& p = world.particles();
+    largest = std::max(largest, std::abs(p.velocity[0][0] + p.angular_velocity[0] * radius));
+    if (largest > 1e4 * nudge) break;
+  }
+  return largest / nudge;
+}
+
+TEST(LeapfrogStability, TheTangentialLimitBindsWhereItIsTheShorter) {
+  const double mass = 2.0;
+  const ContactMaterial material{1.0e6, 1.0e6, 1.0, 10.0};
+  EXPECT_NEAR(critical_time_step(material, mass, tangential_mass(mass, 0.0, 0.5)),
+              2.0 / std::sqrt(3.0 * material.tangential_stiffness / mass), 1e-15);
+  const double half_angle = 0.98;  // ωΔt/2
+  const double below = largest_slip_speed_on_floor(0.98, 20000);
+  record("slip_speed_bound_reached", below);
+  record("slip_speed_growth_above", largest_slip_speed_on_floor(1.02, 200));
+  EXPECT_LT(below, 1.001 / std::sqrt(1.0 - half_angle * half_angle));
+  EXPECT_GT(below, 4.0);  // the bound, 5.025, is reached (seen: 5.02519)
+  EXPECT_GT(largest_slip_speed_on_floor(1.02, 200), 1e3);
+}
+
 // A disc dropped from centre height h0 onto the floor, tension allowed so that each bounce
 // returns the speed times e: the k-th apex of the centre is at (h0 − r) e^{2k} + r. Gravity
 // shifts the end of a contact by about g/(ω0 v), here ~1e-3 of the speed, which the stiff
