@@ -538,7 +538,8 @@ void add_job_options(CLI::App& command, JobOptions& options, const std::string& 
                      "override a config key, e.g. --set mill.speed=0.75 (repeatable)");
   command
       .add_option("-j,--threads", options.threads,
-                  "threads to use (default: all available cores); results do not depend on it")
+                  "threads to use (default: all available cores, or OMP_NUM_THREADS); results do "
+                  "not depend on it")
       ->check(CLI::Validator(
           [](const std::string& text) -> std::string {
             // CLI11's own Range says "Value abc not in range" of a word that is no number.
