@@ -69,10 +69,15 @@ void expect_close(const Vec<D>& actual, const Vec<D>& expected) {
   }
 }
 
+/// The law of these tests (restitution 0.5, unused: the dashpots are given).
+LinearSpringDashpot test_law() {
+  return LinearSpringDashpot(
+      ContactMaterial{normal_stiffness, tangential_stiffness, 0.5, friction});
+}
+
 template <int D>
 void check_break_forgets_both_springs() {
-  const LinearSpringDashpot law(
-      ContactMaterial{normal_stiffness, tangential_stiffness, 0.5, friction});
+  const LinearSpringDashpot law = test_law();
   const Vec<D> n = axis<D>(0);
   const Vec<D> y = axis<D>(1);
   ContactHistory<D> history;
@@ -128,8 +133,7 @@ TEST(ContactBreak, PulledApartWhileOverlappingForgetsBothSpringsAndBooksTheirEne
 /// trial force, the spring is set to it, and the step books the dashpot's work and the slip's.
 template <int D>
 void check_slipping_step() {
-  const LinearSpringDashpot law(
-      ContactMaterial{normal_stiffness, tangential_stiffness, 0.5, friction});
+  const LinearSpringDashpot law = test_law();
   const Vec<D> n = axis<D>(0);
   const Vec<D> y = axis<D>(1);
   ContactHistory<D> history;
