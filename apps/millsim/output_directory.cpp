@@ -1,6 +1,7 @@
 #include "output_directory.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <stdlib.h>
 #include <unistd.h>
 
@@ -99,13 +100,22 @@ std::vector<std::string> prepare_output_directory(const fs::path& out, const std
     names.emplace_back(name);
     names.push_back(std::string(name) + ".partial");
   }
-  // A directory under a result's name (not snapshots/, which is ours) is the user's: the run
-  // would fail to write the result there at its end. Refused before anything moves.
+  if (snapshots != Snapshots::untouched) names.emplace_back("snapshots");
+  const auto refuse_clearing = [&](const std::string& why) {
+    return millsim::InputError(
+        fmt::format("{}: output.directory: cannot clear earlier results from \"{}\" ({}); "
+                    "allowed: a directory whose earlier results can be removed",
+                    location, out.string(), why));
+  };
+  // A directory under a result's name (not snapshots/, which is ours) that is not empty is the
+  // user's: the run would fail to write the result there at its end. Refused before anything
+  // moves. An empty one holds nothing to lose and is removed now (it may be one that cannot be
+  // moved: renaming a directory needs write access to it, removing it does not).
   for (const std::string& name : names) {
     std::error_code error;
     if (fs::symlink_status(out / name, error).type() != fs::file_type::directory) continue;
     const bool empty = fs::is_empty(out / name, error);
-    if (error || !empty) {
+    if ((error || !empty) && name != "snapshots") {
       throw millsim::InputError(fmt::format(
           "{}: output.directory: \"{}\" holds a directory {} where the run writes a result "
           "({}); allowed: an output directory where no result's name is taken (remove or "
@@ -113,35 +123,41 @@ std::vector<std::string> prepare_output_directory(const fs::path& out, const std
           location, out.string(), name, error ? error.message() : "not empty",
           (out / name).string()));
     }
+    if (!error && empty && !fs::remove(out / name, error) && error) {
+      throw refuse_clearing(fmt::format("{}: {}", name, error.message()));
+    }
   }
-  if (snapshots != Snapshots::untouched) names.emplace_back("snapshots");
 
   // The earlier results are renamed into a directory of their own in `out`, so that if one
-  // cannot be, those moved are put back and the refusal loses nothing; then it is removed.
+  // cannot be (or a new snapshots/ cannot be made), those moved are put back and the refusal
+  // loses nothing; then that directory is removed.
   std::string aside = (out / ".millsim-earlier-results-XXXXXX").string();
-  if (::mkdtemp(aside.data()) == nullptr) {
-    throw millsim::InputError(fmt::format(
-        "{}: output.directory: cannot clear earlier results from \"{}\" ({}); allowed: a "
-        "directory that can be created and written",
-        location, out.string(), std::strerror(errno)));
-  }
+  if (::mkdtemp(aside.data()) == nullptr) throw refuse_clearing(std::strerror(errno));
   std::vector<std::string> moved;
+  const auto put_back = [&](const std::string& why) {
+    std::vector<std::string> stuck;
+    for (auto back = moved.rbegin(); back != moved.rend(); ++back) {
+      std::error_code error;
+      fs::rename(fs::path(aside) / *back, out / *back, error);
+      if (error) stuck.push_back(*back);
+    }
+    std::error_code ignored;
+    fs::remove(aside, ignored);  // only if it is empty again
+    if (stuck.empty()) return refuse_clearing(why);
+    return refuse_clearing(fmt::format("{}; and {} could not be put back: they are in {}/", why,
+                                       fmt::join(stuck, ", "), aside));
+  };
   for (const std::string& name : names) {
     std::error_code error;
     if (fs::symlink_status(out / name, error).type() == fs::file_type::not_found) continue;
     fs::rename(out / name, fs::path(aside) / name, error);
-    if (error) {
-      std::error_code ignored;
-      for (auto back = moved.rbegin(); back != moved.rend(); ++back) {
-        fs::rename(fs::path(aside) / *back, out / *back, ignored);
-      }
-      fs::remove(aside, ignored);  // only if it is empty again
-      throw millsim::InputError(fmt::format(
-          "{}: output.directory: cannot clear earlier results from \"{}\" ({}: {}); allowed: a "
-          "directory whose earlier results can be removed",
-          location, out.string(), name, error.message()));
-    }
+    if (error) throw put_back(fmt::format("{}: {}", name, error.message()));
     moved.push_back(name);
+  }
+  if (snapshots == Snapshots::made) {
+    std::error_code error;
+    fs::create_directory(out / "snapshots", error);
+    if (error) throw put_back(fmt::format("snapshots: cannot make it: {}", error.message()));
   }
   std::vector<std::string> warnings;
   std::error_code error;
@@ -151,16 +167,6 @@ std::vector<std::string> prepare_output_directory(const fs::path& out, const std
         "an earlier run's results were moved aside to {}/ but could not all be removed ({}): "
         "remove that directory yourself",
         aside, error.message()));
-  }
-  if (snapshots == Snapshots::made) {
-    try {
-      fs::create_directories(out / "snapshots");
-    } catch (const fs::filesystem_error& failure) {
-      throw millsim::InputError(fmt::format(
-          "{}: output.directory: cannot make \"{}\" ({}); allowed: a directory that can be "
-          "created and written",
-          location, (out / "snapshots").string(), failure.code().message()));
-    }
   }
   return warnings;
 }

@@ -21,11 +21,12 @@ enum class Snapshots { untouched, removed, made };
 
 /// Creates `out`, checks that a file can be written in it, and clears the `results`, their
 /// NAME.partial files (what a killed run leaves) and, unless untouched, snapshots/ that an
-/// earlier run left in it. A result's name taken by a directory of the user's (not empty) is
-/// refused before anything moves. The rest are moved aside with renames in `out` (put back if
-/// one fails, so that a refusal loses nothing), then removed. Returns warnings for the run to
-/// print (what could be moved aside but not removed). Throws InputError naming `location`
-/// (config line, --set or --out) if the directory cannot be used.
+/// earlier run left in it (and makes snapshots/ again, empty, if `made`). A result's name taken
+/// by a directory of the user's (not empty) is refused before anything moves; an empty one is
+/// removed. The rest are moved aside with renames in `out` (put back if one fails, or if
+/// snapshots/ cannot be made, so that a refusal loses nothing), then removed. Returns warnings
+/// for the run to print (what could be moved aside but not removed). Throws InputError naming
+/// `location` (config line, --set or --out) if the directory cannot be used.
 std::vector<std::string> prepare_output_directory(const std::filesystem::path& out,
                                                   const std::string& location,
                                                   std::initializer_list<const char*> results,

@@ -528,6 +528,31 @@ TEST_F(Cli, AResultsPartialNameTakenByADirectoryIsRefusedBeforeTheRun) {
   EXPECT_TRUE(fs::exists(work_ / "taken" / "spectrum.csv.partial" / "mine"));
 }
 
+TEST_F(Cli, AResultThatCannotBeMovedAsideRefusesTheRunAndPutsBackThoseThatWere) {
+  // The earlier results are renamed into out/.millsim-earlier-results-XXXXXX/ before they are
+  // removed. A path of 4046 characters leaves room for out/power_timeseries.csv (4067) but not
+  // for it moved aside (4099, beyond the system's 4095): summary.json and power.csv are moved
+  // first, then that rename fails, and they must be put back.
+  write_config(base_config);
+  std::string out(200, 'a');
+  for (int k = 1; k < 19; ++k) out += "/" + std::string(200, 'a');
+  out += "/" + std::string(227, 'b');
+  ASSERT_EQ(out.size(), 4046U);
+  ASSERT_EQ(millsim("run mill.toml -q -o " + out + " " + tiny_run).status, 0);
+  const std::string summary = read_all(work_ / out / "summary.json");
+  const std::string power = read_all(work_ / out / "power.csv");
+  const Outcome again = millsim("run mill.toml -q -o " + out + " " + tiny_run);
+  EXPECT_EQ(again.status, 2) << again.err;
+  EXPECT_NE(again.err.find("cannot clear earlier results from"), std::string::npos) << again.err;
+  EXPECT_NE(again.err.find("(power_timeseries.csv: File name too long)"), std::string::npos)
+      << again.err;
+  EXPECT_EQ(read_all(work_ / out / "summary.json"), summary);
+  EXPECT_EQ(read_all(work_ / out / "power.csv"), power);
+  for (const auto& entry : fs::directory_iterator(work_ / out)) {
+    EXPECT_FALSE(entry.path().filename().string().starts_with(".millsim")) << entry.path();
+  }
+}
+
 TEST_F(Cli, AnUnknownCommandIsNamed) {
   const Outcome o = millsim("frobnicate mill.toml");
   EXPECT_EQ(o.status, 2) << o.err;
