@@ -85,7 +85,8 @@ fi  # a given MILLSIM_BUILD is used as it is (not rebuilt)
 bench="$build/bench/millsim_scene_bench"
 millsim="$build/millsim"
 src=${MILLSIM_SOURCE:-.}
-echo "== millsim: $build (source $src: $(git -C "$src" rev-parse --short HEAD 2>/dev/null || echo 'not a git tree')$(git -C "$src" diff --quiet 2>/dev/null || echo ', with uncommitted changes'))"
+# The revision the binaries were built from, and the tree whose headers --power compiles against.
+echo "== millsim: $build ($("$millsim" --version); source $src: $(git -C "$src" rev-parse --short HEAD 2>/dev/null || echo 'not a git tree')$(git -C "$src" diff --quiet HEAD 2>/dev/null || echo ', with uncommitted changes'))"
 
 mkdir -p "$work"
 work=$(cd "$work" && pwd)

@@ -7,16 +7,29 @@
 # 1/15 of the smallest ball-ball contact (`millsim info bench/sag-12m-2d.toml` gives it:
 # 0.0008989 s):
 #   bench/run_sag_benchmark.sh 2 runs/bench/sag-12m-2d-t15 --set simulation.time_step=5.993e-5
+# MILLSIM_BUILD=DIR uses the build in DIR as it is; otherwise this installs what is missing and
+# builds build/release first.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
-cmake --preset release >/dev/null
-cmake --build --preset release --target millsim >/dev/null
-threads=${1:-1}
-out=${2:-runs/bench/sag-12m-2d}
-shift $(( $# < 2 ? $# : 2 ))
+usage="usage: $0 [THREADS] [OUTPUT_DIRECTORY] [--set KEY=VALUE ...]"
+threads=1
+out=runs/bench/sag-12m-2d
+# The positionals are optional: whatever comes before the first --set.
+if [ $# -gt 0 ] && [ "$1" != --set ]; then threads=$1; shift; fi
+if [ $# -gt 0 ] && [ "$1" != --set ]; then out=$1; shift; fi
+case "$threads" in ''|*[!0-9]*|0) echo "$usage (THREADS: a whole number from 1)" >&2; exit 2 ;; esac
+for argument in "$@"; do
+  case "$argument" in --set|*=*) ;; *) echo "$usage (\"$argument\" is not --set KEY=VALUE)" >&2; exit 2 ;; esac
+done
+build=${MILLSIM_BUILD:-build/release}
+if [ -z "${MILLSIM_BUILD:-}" ]; then
+  bash scripts/install-deps.sh
+  cmake --preset release >/dev/null
+  cmake --build --preset release --target millsim >/dev/null
+fi
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'), $threads thread(s)"
-./build/release/millsim run -q -j "$threads" bench/sag-12m-2d.toml --out "$out" "$@"
+echo "millsim: $build ($("$build/millsim" --version))"
+"$build/millsim" run -q -j "$threads" bench/sag-12m-2d.toml --out "$out" "$@"
 # Real-time factor: simulated mill seconds (settling included) per wall second; and the same for
 # the turning alone (after settling: the spin-up and the revolutions).
 settle=$(awk -F'= *' '/^settle_time/ {print $2 + 0}' bench/sag-12m-2d.toml)

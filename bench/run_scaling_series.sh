@@ -52,7 +52,8 @@ bench="$build/bench/millsim_scene_bench"
 
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'), $(nproc) cores;" \
   "load average $(cut -d' ' -f1-3 /proc/loadavg); $threads thread(s)"
-echo "millsim: $build ($(git rev-parse --short HEAD 2>/dev/null || echo 'not a git tree')$(git diff --quiet 2>/dev/null || echo ', with uncommitted changes'))"
+# The revision the binaries were built from (the millsim beside the bench), not the tree's.
+echo "millsim: $build ($("$build/millsim" --version))"
 
 mkdir -p "$work"
 state="$work/base.state"

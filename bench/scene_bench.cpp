@@ -15,6 +15,7 @@
 //
 //   millsim_scene_bench CONFIG [--steps N] [--warmup N] [--threads N] [--set KEY=VALUE ...]
 //                       [--save-state FILE] [--load-state FILE] [--tile K] [--shuffle]
+//                       [--cell-order N]
 #include <fmt/format.h>
 #include <omp.h>
 
@@ -25,6 +26,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <numeric>
 #include <optional>
@@ -364,10 +366,34 @@ void check_options(const millsim::MillPlan& plan, const BenchOptions& options) {
                     "mill.periodic = true); only a slab invariant along its axis can be tiled",
                     options.tile, plan.config.source));
   }
+  // As many particles as a mill may plan (charge.cpp): 5e7, about 55 GB at 1.1 kB a ball.
+  constexpr double most_tiled = 5e7;
+  const double tiled = static_cast<double>(options.tile) * static_cast<double>(plan.particle_count);
+  if (tiled > most_tiled) {
+    throw millsim::InputError(fmt::format(
+        "--tile {}: {} copies of {} particles are {:.3g}; allowed: at most {:.0e} particles "
+        "(about {:.0f} GB): --tile up to {} for this slab",
+        options.tile, options.tile, plan.particle_count, tiled, most_tiled,
+        most_tiled * 1.1e3 / 1e9,
+        static_cast<long>(most_tiled / static_cast<double>(plan.particle_count))));
+  }
   if ((options.tile > 1 || options.shuffle) && !options.save_path.empty()) {
     throw millsim::InputError(
         "--save-state: cannot be combined with --tile or --shuffle (the state would not be "
         "one of this config's)");
+  }
+  // A state file that cannot be written is found now, not after the settling and the timed
+  // steps. (A file made for the check alone is removed again.)
+  if (!options.save_path.empty()) {
+    std::error_code error;
+    const bool existed = std::filesystem::exists(options.save_path, error);
+    const bool writable = static_cast<bool>(std::ofstream(options.save_path, std::ios::app));
+    if (!existed) std::filesystem::remove(options.save_path, error);
+    if (!writable) {
+      throw millsim::InputError(
+          fmt::format("--save-state: cannot write {}; allowed: a file path that can be written",
+                      options.save_path));
+    }
   }
 }
 
@@ -380,20 +406,24 @@ int run_bench(int argc, char** argv) {
   std::vector<std::string> overrides;
   app.add_option("config", config_path, "mill config (TOML)")->required();
   app.add_option("--steps", options.steps, "steps to time after settling and spin-up")
-      ->check(CLI::Range(1L, 1000000000L));
+      ->check(CLI::Range(1L, 1000000000L))
+      ->capture_default_str();
   app.add_option("--warmup", options.warmup, "untimed steps at full speed after settling")
-      ->check(CLI::Range(0L, 1000000000L));
+      ->check(CLI::Range(0L, 1000000000L))
+      ->capture_default_str();
   app.add_option("-j,--threads", threads, "threads (default: all cores)")
       ->check(CLI::Range(1, 1024));
   app.add_option("--set", overrides, "override a config key (repeatable)");
   app.add_option("--load-state", options.load_path, "start from this state instead of settling");
   app.add_option("--save-state", options.save_path, "write the state after the timed steps here");
   app.add_option("--tile", options.tile,
-                 "time K copies of the settled periodic slab, end to end along the axis")
+                 "time K copies of the settled periodic slab, end to end along the axis (a "
+                 "periodic 3D slab only; at most 5e7 particles in all)")
       ->check(CLI::Range(1, 1000000));
   app.add_option("--cell-order", options.cell_order,
                  "renumber particles into cell order every N rebuilds, 0 never (default: as "
-                 "millsim run)")
+                 "millsim run, " +
+                     std::to_string(millsim::cell_order_interval) + ")")
       ->check(CLI::Range(0, 1000000));
   app.add_flag("--shuffle", options.shuffle,
                "put the timed particles in an order drawn at random (fixed seed)");
