@@ -25,7 +25,7 @@ if [ $# -lt 4 ] || [ "$4" != "--" ]; then
   exit 2
 fi
 pairs=$1
-case "$pairs" in '' | *[!0-9]* | 0)
+case "$pairs" in '' | *[!0-9]* | 0*)
   echo "$0: PAIRS must be a whole number from 1, not '$pairs'" >&2
   exit 2
   ;;
@@ -34,10 +34,12 @@ bench_a=$2
 bench_b=$3
 shift 4
 rate_of() {
-  local rate
-  rate=$("$@" 2>&1 | awk '/^particle-steps\/s/ {print $2}')
+  local output rate
+  output=$("$@" 2>&1) || true
+  rate=$(awk '/^particle-steps\/s/ {print $2}' <<< "$output")
   if [ -z "$rate" ]; then
     echo "$0: no particle-steps/s line from: $*" >&2
+    tail -n 5 <<< "$output" >&2  # the bench's own message
     exit 1
   fi
   echo "$rate"
