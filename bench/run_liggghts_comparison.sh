@@ -94,13 +94,15 @@ state="$work/settled.state"
 
 settle_cmd=("$bench" "$config" --set simulation.settle_time=$settle --warmup 0 --steps 1 -j 1
             --save-state "$state")
-if [ -f "$state" ] && [ "$(cat "$work/settled.cmd" 2>/dev/null)" = "${settle_cmd[*]:1}" ]; then
+# Reused while the command and the config's text are the same.
+settle_key="${settle_cmd[*]:1} config md5 $(md5sum < "$config" | cut -d' ' -f1)"
+if [ -f "$state" ] && [ "$(cat "$work/settled.cmd" 2>/dev/null)" = "$settle_key" ]; then
   echo "== settled state: reusing $state"
 else
   echo "== settling with millsim (settle_time $settle s, 1 thread: the same state for any count)"
   rm -f "$work/settled.cmd"
   "${settle_cmd[@]}" | grep -E '^(particles|prepared)'
-  echo "${settle_cmd[*]:1}" > "$work/settled.cmd"
+  echo "$settle_key" > "$work/settled.cmd"
 fi
 
 rate_of_millsim() { awk '/^particle-steps\/s/ {print $2}' "$1"; }

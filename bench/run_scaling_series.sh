@@ -58,14 +58,17 @@ echo "millsim: $build ($("$build/millsim" --version))"
 mkdir -p "$work"
 state="$work/base.state"
 base_cmd=("$bench" "$config" --warmup 0 --steps 33000 -j 1 --save-state "$state")
-if [ -f "$state" ] && [ "$(cat "$work/base.cmd" 2>/dev/null)" = "${base_cmd[*]}" ]; then
+# The state is reused while the command and the config's text are the same (an edited config
+# with the same particle count would otherwise load the old charge).
+base_key="${base_cmd[*]:1} config md5 $(md5sum < "$config" | cut -d' ' -f1)"
+if [ -f "$state" ] && [ "$(cat "$work/base.cmd" 2>/dev/null)" = "$base_key" ]; then
   echo "base slab: reusing $state"
 else
   echo "base slab: settling and turning it once (1 thread): ${base_cmd[*]}"
   rm -f "$work/base.cmd"
   "${base_cmd[@]}" > "$work/base.txt"
   grep -E '^(particles|prepared|timed)' "$work/base.txt"
-  echo "${base_cmd[*]}" > "$work/base.cmd"
+  echo "$base_key" > "$work/base.cmd"
 fi
 
 # One run of a point: round, K, warmup steps, timed steps, then extra options. Full output in
