@@ -65,12 +65,11 @@ std::optional<double> read_number(std::string_view text) {
 std::vector<std::size_t> top_level_positions(std::string_view text, char separator) {
   std::vector<std::size_t> positions;
   int depth = 0;
-  std::size_t value_start = 0;
+  bool value_started = false;  // a character other than a blank seen since the last separator
   for (std::size_t i = 0; i < text.size();) {
     const char c = text[i];
-    const bool opens_here =
-        depth > 0 || text.substr(value_start, i - value_start).find_first_not_of(" \t") ==
-                         std::string_view::npos;
+    const bool opens_here = depth > 0 || !value_started;
+    if (c != ' ' && c != '\t') value_started = true;
     if (opens_here && (c == '"' || c == '\'')) {
       const std::size_t quotes = text.substr(i, 3) == std::string(3, c) ? 3 : 1;
       const std::string_view closing = text.substr(i, quotes);
@@ -87,7 +86,7 @@ std::vector<std::size_t> top_level_positions(std::string_view text, char separat
       --depth;
     } else if (depth == 0 && c == separator) {
       positions.push_back(i);
-      value_start = i + 1;
+      value_started = false;
     }
     ++i;
   }
