@@ -48,6 +48,10 @@ for arg in "$@"; do
   esac
 done
 rounds=3
+if [ "${#numbers[@]}" -gt 2 ]; then
+  echo "usage: $0 [STEPS [ROUNDS]] | $0 --power [LIFT [WINDOW]]: at most two numbers" >&2
+  exit 2
+fi
 if [ "$mode" = speed ]; then
   steps=${numbers[0]:-$steps}
   rounds=${numbers[1]:-$rounds}
@@ -58,6 +62,13 @@ if [ "$mode" = speed ]; then
 else
   lift=${numbers[0]:-$lift}
   window=${numbers[1]:-$window}
+  # LIGGGHTS averages the torque over blocks of 100 steps (make_input.py), so the window is
+  # whole blocks; the lift may be 0 (the window then starts as the shell starts to turn).
+  if [ $((10#$window)) -eq 0 ] || [ $((10#$window % 100)) -ne 0 ]; then
+    echo "usage: $0 --power [LIFT [WINDOW]]: WINDOW must be a positive multiple of 100 steps," \
+      "not $window" >&2
+    exit 2
+  fi
 fi
 warmup=1000
 settle=${SETTLE_TIME:-0.4}
