@@ -20,14 +20,17 @@
 #include <vector>
 
 #include "millsim/core/version.hpp"
+#include "support/config_text.hpp"
 #include "support/program_test.hpp"
 
 namespace {
 
+using millsim::testing::line_of;
 using millsim::testing::Outcome;
 using millsim::testing::ProgramTest;
 using millsim::testing::quoted;
 using millsim::testing::read_all;
+using millsim::testing::with;
 
 namespace fs = std::filesystem;
 
@@ -62,44 +65,9 @@ constexpr const char* tiny_run =
     "--set simulation.revolutions=1 --set simulation.measure_revolutions=1 "
     "--set simulation.settle_time=0.01 --set output.snapshot_interval=0";
 
-/// The 1-based number of the first line that starts with `start` (0 if none).
-int line_of(std::string_view text, std::string_view start) {
-  int line = 1;
-  std::size_t at = 0;
-  while (at <= text.size()) {
-    if (text.substr(at).starts_with(start)) return line;
-    const auto end = text.find('\n', at);
-    if (end == std::string_view::npos) break;
-    at = end + 1;
-    ++line;
-  }
-  return 0;
-}
-
-/// `text` with its first line starting with `start` replaced by `replacement` (empty: removed).
-std::string with(std::string_view text, std::string_view start, std::string_view replacement) {
-  const int line = line_of(text, start);
-  EXPECT_GT(line, 0) << "no line starts with " << start;
-  std::string out;
-  int n = 1;
-  std::size_t at = 0;
-  while (at < text.size()) {
-    auto end = text.find('\n', at);
-    if (end == std::string_view::npos) end = text.size();
-    if (n == line) {
-      if (!replacement.empty()) out += std::string(replacement) + "\n";
-    } else {
-      out += std::string(text.substr(at, end - at)) + "\n";
-    }
-    at = end + 1;
-    ++n;
-  }
-  return out;
-}
-
 /// "mill.toml:LINE" for the line of `text` that starts with `start`.
 std::string at_line(std::string_view text, std::string_view start) {
-  return "mill.toml:" + std::to_string(line_of(text, start));
+  return millsim::testing::at_line("mill.toml", text, start);
 }
 
 class Cli : public ProgramTest {

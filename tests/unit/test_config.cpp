@@ -12,9 +12,13 @@
 #include "millsim/core/error.hpp"
 #include "millsim/io/config.hpp"
 #include "millsim/io/toml_reader.hpp"
+#include "support/config_text.hpp"
 
 namespace millsim {
 namespace {
+
+using testing::line_of;
+using testing::with;
 
 // A small complete config; the tests change one line of it at a time.
 constexpr std::string_view base_config = R"([simulation]
@@ -44,45 +48,9 @@ snapshot_interval = 0.05
 
 constexpr const char* file_name = "mill.toml";
 
-/// The 1-based number of the first line that starts with `start` (0 if none).
-int line_of(std::string_view text, std::string_view start) {
-  int line = 1;
-  std::size_t at = 0;
-  while (at <= text.size()) {
-    if (text.substr(at).starts_with(start)) return line;
-    const auto end = text.find('\n', at);
-    if (end == std::string_view::npos) break;
-    at = end + 1;
-    ++line;
-  }
-  return 0;
-}
-
-/// `text` with its first line starting with `start` replaced by `replacement` (which may hold
-/// several lines, or be empty to remove the line).
-std::string with(std::string_view text, std::string_view start, std::string_view replacement) {
-  const int line = line_of(text, start);
-  EXPECT_GT(line, 0) << "no line starts with " << start;
-  std::string out;
-  int n = 1;
-  std::size_t at = 0;
-  while (at < text.size()) {
-    auto end = text.find('\n', at);
-    if (end == std::string_view::npos) end = text.size();
-    if (n == line) {
-      if (!replacement.empty()) out += std::string(replacement) + "\n";
-    } else {
-      out += std::string(text.substr(at, end - at)) + "\n";
-    }
-    at = end + 1;
-    ++n;
-  }
-  return out;
-}
-
 /// "mill.toml:LINE" for the line of `text` that starts with `start`.
 std::string at_line(std::string_view text, std::string_view start) {
-  return std::string(file_name) + ":" + std::to_string(line_of(text, start));
+  return millsim::testing::at_line(file_name, text, start);
 }
 
 /// The message of the InputError that reading `text` throws; a test failure if none.
