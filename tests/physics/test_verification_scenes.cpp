@@ -299,7 +299,7 @@ TEST_F(VerificationScene, FreeFallIsExact) {
     ASSERT_EQ(path.rows.size(), 51u) << name;
     const std::string up = d == 3 ? "z" : "y";
     for (std::size_t row = 0; row < path.rows.size(); ++row) {
-      const double t = path.at(row, "time");
+      const double t = path.at(row, "time_s");
       EXPECT_NEAR(path.at(row, "x"), 2.0 * t, 1e-9) << name << " t = " << t;
       EXPECT_NEAR(path.at(row, up), 2.0 * t - 0.5 * g * t * t, 1e-9) << name << " t = " << t;
       EXPECT_NEAR(path.at(row, "v" + up), 2.0 - g * t, 1e-9) << name << " t = " << t;
@@ -322,9 +322,9 @@ TEST_F(VerificationScene, SlidingBodiesStartRollingWhenAndAsFastAsTheorySays) {
     for (std::size_t row = 0; row < path.rows.size(); ++row) {
       // Contact-point velocity along x: v_x − R ω_y (sphere), v_x + R ω (disc).
       const double slip = d == 3 ? path.at(row, "vx") - radius * path.at(row, "wy")
-                                 : path.at(row, "vx") + radius * path.at(row, "w");
+                                 : path.at(row, "vx") + radius * path.at(row, "omega");
       if (std::abs(slip) < 1e-3 * v0) {
-        rolling_from = path.at(row, "time");
+        rolling_from = path.at(row, "time_s");
         break;
       }
     }

@@ -105,24 +105,38 @@ TEST(ParticleOrder, RenumberedParticlesKeepTheirIdsContactsAndPhysics) {
 }
 
 // A snapshot of a renumbered world lists the particles by id, 0, 1, 2, ..., each with its own
-// radius and position.
+// radius and position, written so that they read back to the same doubles; index.csv names it
+// with its time.
 TEST(ParticleOrder, SnapshotListsParticlesById) {
   const World<2> world = falling_charge(1, 1000);
   ASSERT_GT(renumbered(world), 0u);
   const auto directory = std::filesystem::temp_directory_path() / "millsim-particle-order";
+  std::filesystem::remove_all(directory);
   std::filesystem::create_directories(directory);
-  write_snapshot(directory, 0, world);
+  {
+    SnapshotWriter snapshots(directory);
+    snapshots.write(world);
+  }
   const std::vector<std::string> lines = lines_of(directory / "snapshot_000000.csv");
   const ParticleStore<2> by_id = world.particles_by_id();
-  ASSERT_EQ(lines.size(), by_id.size() + 2);
+  ASSERT_EQ(lines.size(), by_id.size() + 1);
+  EXPECT_EQ(lines[0], "id,x,y,vx,vy,omega,radius,fx,fy");
   for (std::size_t id = 0; id < by_id.size(); ++id) {
-    const std::vector<std::string> fields = fields_of(lines[id + 2]);
+    const std::vector<std::string> fields = fields_of(lines[id + 1]);
     ASSERT_EQ(fields.size(), 9u);
     EXPECT_EQ(fields[0], fmt::format("{}", id));
-    EXPECT_EQ(fields[1], fmt::format("{:.7g}", by_id.position[id][0])) << "particle " << id;
-    EXPECT_EQ(fields[2], fmt::format("{:.7g}", by_id.position[id][1])) << "particle " << id;
-    EXPECT_EQ(fields[6], fmt::format("{:.7g}", by_id.radius[id])) << "particle " << id;
+    EXPECT_EQ(std::stod(fields[1]), by_id.position[id][0]) << "particle " << id;
+    EXPECT_EQ(std::stod(fields[2]), by_id.position[id][1]) << "particle " << id;
+    EXPECT_EQ(std::stod(fields[6]), by_id.radius[id]) << "particle " << id;
   }
+  const std::vector<std::string> index = lines_of(directory / "index.csv");
+  ASSERT_EQ(index.size(), 2u);
+  EXPECT_EQ(index[0], "snapshot,file,time_s,shell_angle_rad");
+  const std::vector<std::string> row = fields_of(index[1]);
+  ASSERT_EQ(row.size(), 4u);
+  EXPECT_EQ(row[0], "0");
+  EXPECT_EQ(row[1], "snapshot_000000.csv");
+  EXPECT_EQ(std::stod(row[2]), world.time());
   std::filesystem::remove_all(directory);
 }
 

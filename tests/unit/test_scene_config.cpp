@@ -244,11 +244,11 @@ TEST(SceneRun, WritesTrajectoryFinalAndSummaryAndNothingPartial) {
   // The summary names the program that made it.
   std::ifstream summary(work / "out" / "summary.json");
   const std::string json((std::istreambuf_iterator<char>(summary)), {});
-  EXPECT_NE(json.find("\"millsim_version\": \"" + millsim::version_text() + "\""),
+  EXPECT_NE(json.find("\"millsim_version\" : \"" + millsim::version_text() + "\""),
             std::string::npos)
       << json;
-  EXPECT_NE(json.find("\"shortest_contact_duration_s\": "), std::string::npos) << json;
-  EXPECT_NE(json.find("\"critical_time_step_s\": "), std::string::npos) << json;
+  EXPECT_NE(json.find("\"shortest_contact_duration_s\" : "), std::string::npos) << json;
+  EXPECT_NE(json.find("\"critical_time_step_s\" : "), std::string::npos) << json;
 
   // A particle that can touch nothing (no wall, no other particle) has no contact duration and
   // no stability limit: the summary leaves both out rather than write 0.
@@ -260,7 +260,15 @@ TEST(SceneRun, WritesTrajectoryFinalAndSummaryAndNothingPartial) {
   const std::string alone_json((std::istreambuf_iterator<char>(alone_summary)), {});
   EXPECT_EQ(alone_json.find("shortest_contact_duration_s"), std::string::npos) << alone_json;
   EXPECT_EQ(alone_json.find("critical_time_step_s"), std::string::npos) << alone_json;
-  EXPECT_NE(alone_json.find("\"wall_count\": 0"), std::string::npos) << alone_json;
+  EXPECT_NE(alone_json.find("\"wall_count\" : 0,"), std::string::npos) << alone_json;
+
+  // A config whose name holds a quote and a backslash: the summary's strings are escaped, so
+  // that it stays JSON.
+  std::ofstream(work / "a\"b\\c.toml") << drop;
+  ASSERT_EQ(millsim_in(work, "run 'a\"b\\c.toml' -q --out odd"), 0);
+  std::ifstream odd_summary(work / "odd" / "summary.json");
+  const std::string odd_json((std::istreambuf_iterator<char>(odd_summary)), {});
+  EXPECT_NE(odd_json.find(R"("config" : "a\"b\\c.toml",)"), std::string::npos) << odd_json;
 
   // A refused scene writes nothing.
   std::string bad(drop);

@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
+#include <utility>
 
 #include "millsim/core/version.hpp"
 #include "millsim/io/partial_file.hpp"
@@ -20,12 +22,12 @@ namespace {
 
 std::string power_table(const std::vector<PowerInterval>& rows, bool numbered) {
   std::string text = numbered ? "revolution," : "";
-  text += "start_s,end_s,torque_nm,power_kw,dissipation_kw,kinetic_energy_slice_j\n";
+  text += "start_s,end_s,torque_nm,power_kw,power_dissipation_kw,kinetic_energy_slice_j\n";
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const PowerInterval& p = rows[k];
     if (numbered) text += fmt::format("{},", k + 1);
-    text += fmt::format("{:.6f},{:.6f},{:.6g},{:.6g},{:.6g},{:.6g}\n", p.start_time, p.end_time,
-                        p.torque, p.power / 1000.0, p.dissipation_power / 1000.0, p.kinetic_energy);
+    text += fmt::format("{},{},{},{},{},{}\n", p.start_time, p.end_time, p.torque, p.power / 1000.0,
+                        p.dissipation_power / 1000.0, p.kinetic_energy);
   }
   return text;
 }
@@ -43,10 +45,9 @@ std::string impacts_table(const MillResult& result) {
   const ShellImpacts& impacts = *result.shell_impacts;
   const double window = result.window_end.time - result.window_start.time;
   for (int k = 0; k < ShellImpacts::bins; ++k) {
-    text += fmt::format("{:.6f},{:.6f}", k * ShellImpacts::bin_width,
-                        (k + 1) * ShellImpacts::bin_width);
+    text += fmt::format("{},{}", k * ShellImpacts::bin_width, (k + 1) * ShellImpacts::bin_width);
     for (const ContactType t : types) {
-      text += fmt::format(",{},{:.6g},{:.6g}", impacts.count(t, k),
+      text += fmt::format(",{},{},{}", impacts.count(t, k),
                           static_cast<double>(impacts.count(t, k)) / window, impacts.energy(t, k));
     }
     text += "\n";
@@ -60,7 +61,7 @@ std::string charge_profile_table(const MillResult& result) {
   if (!result.charge_profile) return text;
   const ChargeProfile& profile = *result.charge_profile;
   for (int k = 0; k < ChargeProfile::bins; ++k) {
-    text += fmt::format("{:.6f},{:.6f},{:.6g}\n", k * ChargeProfile::bin_width,
+    text += fmt::format("{},{},{}\n", k * ChargeProfile::bin_width,
                         (k + 1) * ChargeProfile::bin_width, profile.mean_count(k));
   }
   return text;
@@ -83,13 +84,13 @@ std::string spectrum_table(const MillResult& result) {
   std::vector<double> cumulative(types.size(), 0.0);
   double wall_cumulative = 0.0;
   for (std::size_t bin = 0; bin < s.bin_count(); ++bin) {
-    text += fmt::format("{:.4g},{:.4g}", s.bin_lower_edge(bin), s.bin_upper_edge(bin));
+    text += fmt::format("{},{}", s.bin_lower_edge(bin), s.bin_upper_edge(bin));
     long wall_count = 0;
     double wall_energy = 0.0;
     for (std::size_t k = 0; k < types.size(); ++k) {
       const ContactType t = types[k];
       cumulative[k] += s.energy(t, bin);
-      text += fmt::format(",{},{:.6g},{:.6g},{:.6g}", s.count(t, bin),
+      text += fmt::format(",{},{},{},{}", s.count(t, bin),
                           static_cast<double>(s.count(t, bin)) / window, s.energy(t, bin),
                           cumulative[k]);
       if (t != ContactType::ball_ball) {
@@ -98,8 +99,8 @@ std::string spectrum_table(const MillResult& result) {
       }
     }
     wall_cumulative += wall_energy;
-    text += fmt::format(",{},{:.6g},{:.6g},{:.6g}\n", wall_count,
-                        static_cast<double>(wall_count) / window, wall_energy, wall_cumulative);
+    text += fmt::format(",{},{},{},{}\n", wall_count, static_cast<double>(wall_count) / window,
+                        wall_energy, wall_cumulative);
   }
   return text;
 }
@@ -166,6 +167,9 @@ std::vector<SummaryNumber> summary_numbers(const MillResult& r) {
       {"speed_fraction_of_critical", plan.speed_fraction},
       {"particle_count", count(plan.particle_count), true},
       {"time_step_s", plan.time_step},
+      {"critical_time_step_s", plan.critical_time_step},
+      {"shortest_contact_duration_s",
+       std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall)},
       {"steps", count(r.steps), true},
       {"simulated_seconds", r.simulated_seconds},
       {"wall_seconds", r.wall_seconds},
@@ -215,40 +219,70 @@ void insert_number(toml::table& table, const SummaryNumber& number) {
 
 }  // namespace
 
-void write_snapshot(const std::filesystem::path& directory, int index, const World<3>& world) {
-  PartialFile out(directory / fmt::format("snapshot_{:06d}.csv", index));
+namespace {
+
+/// A snapshot's rows: each particle by id, with its velocity and spin at the time of the
+/// positions, every number in the shortest text that reads back to the same double.
+void write_particles(PartialFile& out, const World<3>& world) {
   const auto& p = world.particles();
-  out.print("# time_s = {:.9g}, shell_angle_rad = {:.9g}\n", world.time(),
-            world.walls().mill ? world.walls().mill->angle : 0.0);
-  out.print("id,x,y,z,vx,vy,vz,wx,wy,wz,radius,fx,fy,fz\n");
+  out.write("id,x,y,z,vx,vy,vz,wx,wy,wz,radius,fx,fy,fz\n");
   for (std::size_t id = 0; id < p.size(); ++id) {
     const std::size_t i = world.particle_index(id);
     const Vec3& x = p.position[i];
-    const Vec3& v = p.velocity[i];
-    const Vec3& w = p.angular_velocity[i];
+    const auto [v, w] = motion_at_positions(world, i);
     const Vec3& f = p.force[i];
-    out.print(
-        "{},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},"
-        "{:.7g},{:.7g}\n",
-        id, x[0], x[1], x[2], v[0], v[1], v[2], w[0], w[1], w[2], p.radius[i], f[0], f[1], f[2]);
+    out.print("{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", id, x[0], x[1], x[2], v[0], v[1], v[2],
+              w[0], w[1], w[2], p.radius[i], f[0], f[1], f[2]);
   }
-  out.commit();
 }
 
-void write_snapshot(const std::filesystem::path& directory, int index, const World<2>& world) {
-  PartialFile out(directory / fmt::format("snapshot_{:06d}.csv", index));
+void write_particles(PartialFile& out, const World<2>& world) {
   const auto& p = world.particles();
-  out.print("# time_s = {:.9g}, shell_angle_rad = {:.9g}\n", world.time(),
-            world.walls().mill ? world.walls().mill->angle : 0.0);
-  out.print("id,x,y,vx,vy,omega,radius,fx,fy\n");
+  out.write("id,x,y,vx,vy,omega,radius,fx,fy\n");
   for (std::size_t id = 0; id < p.size(); ++id) {
     const std::size_t i = world.particle_index(id);
-    out.print("{},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g}\n", id, p.position[i][0],
-              p.position[i][1], p.velocity[i][0], p.velocity[i][1], p.angular_velocity[i],
-              p.radius[i], p.force[i][0], p.force[i][1]);
+    const Vec2& x = p.position[i];
+    const auto [v, w] = motion_at_positions(world, i);
+    const Vec2& f = p.force[i];
+    out.print("{},{},{},{},{},{},{},{},{}\n", id, x[0], x[1], v[0], v[1], w, p.radius[i], f[0],
+              f[1]);
   }
-  out.commit();
 }
+
+}  // namespace
+
+SnapshotWriter::SnapshotWriter(std::filesystem::path directory)
+    : directory_(std::move(directory)) {}
+
+SnapshotWriter::~SnapshotWriter() {
+  if (index_ != nullptr) std::fclose(index_);
+}
+
+template <int D>
+void SnapshotWriter::write(const World<D>& world) {
+  const std::string name = fmt::format("snapshot_{:06d}.csv", count_);
+  PartialFile out(directory_ / name);
+  write_particles(out, world);
+  out.commit();
+  // The index gets the snapshot's row once the snapshot is whole, so that every file it names
+  // is complete; rows are appended and flushed one by one.
+  const std::filesystem::path index_path = directory_ / "index.csv";
+  if (index_ == nullptr) {
+    index_ = std::fopen(index_path.c_str(), "wb");
+    if (index_ == nullptr)
+      throw std::runtime_error(fmt::format("{}: cannot write", index_path.string()));
+    std::fputs("snapshot,file,time_s,shell_angle_rad\n", index_);
+  }
+  fmt::print(index_, "{},{},{},{}\n", count_, name, world.time(),
+             world.walls().mill ? world.walls().mill->angle : 0.0);
+  if (std::fflush(index_) != 0 || std::ferror(index_) != 0) {
+    throw std::runtime_error(fmt::format("{}: write failed", index_path.string()));
+  }
+  ++count_;
+}
+
+template void SnapshotWriter::write(const World<2>&);
+template void SnapshotWriter::write(const World<3>&);
 
 std::vector<std::pair<std::string, double>> summary_scalars(const MillResult& result) {
   std::vector<std::pair<std::string, double>> scalars;
@@ -265,6 +299,7 @@ std::string summary_json(const MillResult& r) {
         toml::table{{"diameter_m", d.diameter}, {"count", d.count}, {"mass_kg", d.mass}});
   }
   toml::table summary{
+      {"kind", "mill"},
       {"millsim_version", version_text()},
       {"config", c.source},
       {"charge_centre_of_mass_m", toml::array{r.charge_centre[0], r.charge_centre[1]}},

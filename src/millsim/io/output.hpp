@@ -1,6 +1,7 @@
 // What a run writes to its output directory (README "Outputs").
 #pragma once
 
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -12,10 +13,29 @@ namespace millsim {
 
 struct MillResult;
 
-/// snapshots/snapshot_NNNNNN.csv: time, and per particle, in the order of their ids (World's
-/// particle_id), the id, position, velocity, angular velocity, radius and net force.
-void write_snapshot(const std::filesystem::path& directory, int index, const World<2>& world);
-void write_snapshot(const std::filesystem::path& directory, int index, const World<3>& world);
+/// The snapshots of a run (README "Outputs"), in the directory given: snapshot_NNNNNN.csv, one
+/// a call of write, with a row for each particle in the order of their ids (World's
+/// particle_id): id, position, velocity and angular velocity at the time of the positions,
+/// radius and net force; and index.csv, a row for each snapshot written: its number, file,
+/// time and the shell's angle. Errors throw std::runtime_error naming the file.
+class SnapshotWriter {
+ public:
+  explicit SnapshotWriter(std::filesystem::path directory);
+  ~SnapshotWriter();
+  SnapshotWriter(const SnapshotWriter&) = delete;
+  SnapshotWriter& operator=(const SnapshotWriter&) = delete;
+
+  template <int D>
+  void write(const World<D>& world);
+
+ private:
+  std::filesystem::path directory_;
+  int count_ = 0;
+  std::FILE* index_ = nullptr;  // index.csv, open from the first snapshot on
+};
+
+extern template void SnapshotWriter::write(const World<2>&);
+extern template void SnapshotWriter::write(const World<3>&);
 
 /// summary.json, power.csv, power_timeseries.csv, spectrum.csv, charge_profile.csv and
 /// impacts.csv.

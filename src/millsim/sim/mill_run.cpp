@@ -78,10 +78,10 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
   const double series_angle = 2.0 * pi / 50.0;
 
   double next_snapshot = 0.0;
-  int snapshot_index = 0;
+  SnapshotWriter snapshots(snapshot_directory);
   const auto write_snapshot_if_due = [&] {
     if (snapshot_interval <= 0.0 || world.time() + 0.5 * dt < next_snapshot) return;
-    write_snapshot(snapshot_directory, snapshot_index++, world);
+    snapshots.write(world);
     next_snapshot += snapshot_interval;
   };
 

@@ -1,12 +1,15 @@
 #include "millsim/sim/scene_run.hpp"
 
 #include <fmt/format.h>
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
 
@@ -58,22 +61,12 @@ void write_row(std::FILE* file, double time, std::size_t id, const Vec<D>& x, co
   std::fwrite(row.data(), 1, row.size(), file);
 }
 
-/// Velocity and spin of particle i at the time of the positions: the half-step values moved on
-/// by half a step of the last step's acceleration (exact in free flight).
-template <int D>
-std::pair<Vec<D>, Spin<D>> current_motion(const World<D>& world, std::size_t i) {
-  const ParticleStore<D>& p = world.particles();
-  const double half = 0.5 * world.settings().time_step;
-  return {p.velocity[i] + (half * p.inverse_mass[i]) * p.force[i],
-          p.angular_velocity[i] + (half * p.inverse_inertia[i]) * p.torque[i]};
-}
-
 /// Every particle's row, in the order of their ids (the order of the config).
 template <int D>
 void write_state(std::FILE* file, const World<D>& world) {
   for (std::size_t id = 0; id < world.particles().size(); ++id) {
     const std::size_t i = world.particle_index(id);
-    const auto [v, w] = current_motion(world, i);
+    const auto [v, w] = motion_at_positions(world, i);
     write_row<D>(file, world.time(), id, world.particles().position[i], v, w);
   }
 }
@@ -89,15 +82,11 @@ double kinetic_energy(const ParticleStore<D>& p, std::size_t i, const Vec<D>& v,
 
 template <int D>
 std::string header() {
-  return D == 2 ? "time,id,x,y,vx,vy,w\n" : "time,id,x,y,z,vx,vy,vz,wx,wy,wz\n";
+  return D == 2 ? "time_s,id,x,y,vx,vy,omega\n" : "time_s,id,x,y,z,vx,vy,vz,wx,wy,wz\n";
 }
 
 std::string summary_json(const SceneResult& r) {
   const SceneConfig& c = r.plan.config;
-  std::string json = "{\n";
-  const auto add = [&](std::string_view key, const std::string& value, bool last = false) {
-    json += fmt::format("  \"{}\": {}{}\n", key, value, last ? "" : ",");
-  };
   // JSON has no infinity or NaN: a run whose figures are not finite has diverged, and is
   // reported as failed rather than written.
   const auto number = [](double x) {
@@ -105,31 +94,38 @@ std::string summary_json(const SceneResult& r) {
       throw std::runtime_error(fmt::format(
           "the run diverged: a figure of its summary is {} (summary.json not written)", x));
     }
-    return fmt::format("{:.17g}", x);
+    return x;
   };
-  add("kind", "\"scene\"");
-  add("millsim_version", fmt::format("\"{}\"", version_text()));
-  add("config", fmt::format("\"{}\"", c.source));
-  add("dimension", fmt::format("{}", c.dimension));
-  add("particle_count", fmt::format("{}", c.particles.size()));
-  add("wall_count", fmt::format("{}", c.walls.size()));
-  add("time_step_s", number(r.plan.time_step));
+  const auto whole = [](auto n) { return static_cast<std::int64_t>(n); };
+  // Written as the mill's summary is (io/output.cpp): toml++'s JSON writer, which escapes the
+  // strings (a config's path may hold quotes) and orders the keys.
+  toml::table summary{
+      {"kind", "scene"},
+      {"millsim_version", version_text()},
+      {"config", c.source},
+      {"dimension", c.dimension},
+      {"particle_count", whole(c.particles.size())},
+      {"wall_count", whole(c.walls.size())},
+      {"time_step_s", number(r.plan.time_step)},
+      {"steps", whole(r.steps)},
+      {"simulated_seconds", number(r.simulated_seconds)},
+      {"wall_seconds", number(r.wall_seconds)},
+      {"kinetic_energy_start_j", number(r.kinetic_start)},
+      {"kinetic_energy_end_j", number(r.kinetic_end)},
+      {"potential_energy_start_j", number(r.potential_start)},
+      {"potential_energy_end_j", number(r.potential_end)},
+      {"dissipated_j", number(r.dissipated)},
+      {"ball_ball_collisions", whole(r.ball_ball_collisions)},
+      {"ball_wall_collisions", whole(r.ball_wall_collisions)},
+  };
   // A scene whose particles can touch nothing has neither (the plan holds 0 for them).
   if (r.plan.shortest_contact > 0.0) {
-    add("critical_time_step_s", number(r.plan.critical_time_step));
-    add("shortest_contact_duration_s", number(r.plan.shortest_contact));
+    summary.insert("critical_time_step_s", number(r.plan.critical_time_step));
+    summary.insert("shortest_contact_duration_s", number(r.plan.shortest_contact));
   }
-  add("steps", fmt::format("{}", r.steps));
-  add("simulated_seconds", number(r.simulated_seconds));
-  add("wall_seconds", number(r.wall_seconds));
-  add("kinetic_energy_start_j", number(r.kinetic_start));
-  add("kinetic_energy_end_j", number(r.kinetic_end));
-  add("potential_energy_start_j", number(r.potential_start));
-  add("potential_energy_end_j", number(r.potential_end));
-  add("dissipated_j", number(r.dissipated));
-  add("ball_ball_collisions", fmt::format("{}", r.ball_ball_collisions));
-  add("ball_wall_collisions", fmt::format("{}", r.ball_wall_collisions), true);
-  return json + "}\n";
+  std::ostringstream text;
+  text << toml::json_formatter{summary} << "\n";
+  return text.str();
 }
 
 }  // namespace
@@ -273,7 +269,7 @@ SceneResult run_scene_in(const ScenePlan& plan, const std::filesystem::path& dir
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_clock).count();
   for (std::size_t id = 0; id < n; ++id) {
     const std::size_t i = world.particle_index(id);
-    const auto [v, w] = current_motion(world, i);
+    const auto [v, w] = motion_at_positions(world, i);
     result.kinetic_end += kinetic_energy(p, i, v, w);
   }
   result.potential_end = world.potential_energy();

@@ -671,4 +671,16 @@ class World {
 extern template class World<2>;
 extern template class World<3>;
 
+/// Velocity and spin of the particle at index `i` at the time of the positions (what outputs
+/// write): the leapfrog's half-step values moved on by half a step of the last step's
+/// acceleration, exact in free flight. Before the first step the force is zero, and the values
+/// are those given.
+template <int D>
+std::pair<Vec<D>, Spin<D>> motion_at_positions(const World<D>& world, std::size_t i) {
+  const ParticleStore<D>& p = world.particles();
+  const double half = 0.5 * world.settings().time_step;
+  return {p.velocity[i] + (half * p.inverse_mass[i]) * p.force[i],
+          p.angular_velocity[i] + (half * p.inverse_inertia[i]) * p.torque[i]};
+}
+
 }  // namespace millsim
