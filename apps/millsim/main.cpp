@@ -26,6 +26,7 @@
 #include "millsim/core/version.hpp"
 #include "millsim/io/config.hpp"
 #include "millsim/io/output.hpp"
+#include "millsim/io/partial_file.hpp"
 #include "millsim/measure/empirical_power.hpp"
 #include "millsim/sim/mill_run.hpp"
 #include "millsim/sim/scene_run.hpp"
@@ -364,6 +365,13 @@ int validate_command(const std::string& directory, const JobOptions& options) {
     std::optional<double> paper;
   };
   std::vector<Row> rows;
+  // The table of an earlier validation goes before any case runs: a validation that fails
+  // half-way leaves no table from another.
+  const std::filesystem::path table_path = root / "validation.csv";
+  for (const auto& stale : {table_path, std::filesystem::path(table_path.string() + ".partial")}) {
+    std::error_code ignored;
+    std::filesystem::remove(stale, ignored);
+  }
   for (const MillPlan& plan : plans) {
     const MillConfig& config = plan.config;
     const auto started = [&] {
@@ -378,10 +386,17 @@ int validate_command(const std::string& directory, const JobOptions& options) {
   fmt::print("{:<8} {:>12} {:>12} {:>12} {:>9} {:>10}  {}\n", "case", "measured_kW", "paper_kW",
              "millsim_kW", "error_%", "paper_err%", "within");
   int failures = 0;
+  std::string table = millsim::csv_line({"case", "measured_power_kw", "paper_power_kw", "power_kw",
+                                         "error", "paper_error", "tolerance", "within"});
   for (const Row& r : rows) {
     const double error = (r.predicted - r.measured) / r.measured;
     const bool ok = std::abs(error) <= r.tolerance;
     failures += ok ? 0 : 1;
+    table += millsim::csv_line(
+        {r.name, fmt::format("{}", r.measured), r.paper ? fmt::format("{}", *r.paper) : "",
+         fmt::format("{}", r.predicted), fmt::format("{}", error),
+         r.paper ? fmt::format("{}", (*r.paper - r.measured) / r.measured) : "",
+         fmt::format("{}", r.tolerance), ok ? "yes" : "no"});
     // A case without the paper's figure shows n/a in its two columns.
     const std::string paper = r.paper ? fmt::format("{:.4g}", *r.paper) : std::string("n/a");
     const std::string paper_error =
@@ -391,6 +406,8 @@ int validate_command(const std::string& directory, const JobOptions& options) {
                r.measured, paper, r.predicted, 100.0 * error, paper_error, ok ? "yes" : "NO",
                100.0 * r.tolerance);
   }
+  millsim::write_whole_file(table_path, table);
+  if (!options.quiet) fmt::print(stderr, "table in {}\n", table_path.string());
   if (failures > 0) {
     fmt::print(stderr, "millsim: {} of {} cases outside their tolerance\n", failures, rows.size());
     return 1;

@@ -138,6 +138,17 @@ std::vector<std::string> range_values(const std::vector<std::string>& parts,
   return values;
 }
 
+std::optional<double> scalar(const SweepRow& row, std::string_view name) {
+  for (const auto& [key, value] : row.scalars) {
+    if (key == name) return value;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+namespace {
+
 /// A CSV field, quoted when it holds a separator, a quote or a line break (RFC 4180).
 std::string csv_field(const std::string& text) {
   if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
@@ -149,6 +160,8 @@ std::string csv_field(const std::string& text) {
   return quoted + "\"";
 }
 
+}  // namespace
+
 std::string csv_line(const std::vector<std::string>& cells) {
   std::string line;
   for (std::size_t k = 0; k < cells.size(); ++k) {
@@ -158,15 +171,6 @@ std::string csv_line(const std::vector<std::string>& cells) {
   line += '\n';
   return line;
 }
-
-std::optional<double> scalar(const SweepRow& row, std::string_view name) {
-  for (const auto& [key, value] : row.scalars) {
-    if (key == name) return value;
-  }
-  return std::nullopt;
-}
-
-}  // namespace
 
 SweepAxis parse_vary(std::string_view argument) {
   const std::string where = fmt::format("command line (--vary {})", argument);

@@ -62,6 +62,10 @@ struct SweepRow {
   std::vector<std::pair<std::string, double>> scalars;
 };
 
+/// One CSV line of `cells`, ended by a line break; a cell with a comma, quote or line break is
+/// quoted (RFC 4180).
+std::string csv_line(const std::vector<std::string>& cells);
+
 /// sweep.csv: a header `point, <each key>, status, <each scalar name>`, then one row per point.
 /// The scalar columns are the names of all rows in order of first appearance; a row without a
 /// scalar (a failed point) leaves its cell empty. Fields with a comma, quote or line break are
