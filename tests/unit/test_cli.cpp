@@ -14,6 +14,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <iterator>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -115,7 +116,30 @@ TEST_F(Cli, VersionPrintsTheVersionAndTheSourceRevision) {
   const Outcome o = millsim("--version");
   EXPECT_EQ(o.status, 0) << o.err;
   EXPECT_EQ(o.out, "millsim " + millsim::version_text() + "\n");
-  EXPECT_TRUE(o.out.starts_with("millsim 0.1.0 (")) << o.out;
+  // The revision is cmake/version.cmake's `git describe --always --dirty --abbrev=12` of the
+  // source directory at build time: in a checkout without tags, 12 hex digits of the commit
+  // and "-dirty" if the tree had changes; "unknown" when the source is not a git checkout (or git
+  // is missing), as README.md says.
+  const std::regex from_git(R"(millsim 0\.1\.0 \(([0-9a-f]{12})(-dirty)?\)\n)");
+  const std::regex outside_git(R"(millsim 0\.1\.0 \(unknown\)\n)");
+  const fs::path source(MILLSIM_SOURCE_DIR);
+  // The test asks git the same question version.cmake asks: is there a checkout it can read?
+  const bool checkout =
+      fs::exists(source / ".git") &&
+      std::system(
+          ("git -C " + quoted(source.string()) + " rev-parse HEAD >/dev/null 2>&1").c_str()) == 0;
+  std::smatch match;
+  if (checkout) {
+    ASSERT_TRUE(std::regex_match(o.out, match, from_git)) << o.out;
+    // And the digits name a commit of this checkout, not any 12 hex digits.
+    EXPECT_EQ(std::system(("git -C " + quoted(source.string()) + " cat-file -e " + match[1].str() +
+                           "^{commit} 2>/dev/null")
+                              .c_str()),
+              0)
+        << match[1] << " is not a commit of " << source;
+  } else {
+    EXPECT_TRUE(std::regex_match(o.out, outside_git) || std::regex_match(o.out, from_git)) << o.out;
+  }
 }
 
 TEST_F(Cli, RefusesATimeStepAboveTheStabilityLimitAndGivesTheLimit) {
