@@ -208,8 +208,13 @@ TEST(SceneConfig, RefusesParticlesThatOverlapAtTheStart) {
 }
 
 TEST(SceneConfig, RefusesAConfigWithoutParticlesOrMill) {
+  // Walls without a mill make a scene: the refusal is the scene reader's missing [[particles]],
+  // not parse_config's "missing required table [mill], and no [[particles]] either" (which also
+  // holds "particles" and "missing required").
   expect_refused("[simulation]\nduration = 1\n[[walls]]\npoint = [0, 0]\nnormal = [0, 1]\n", {},
-                 {"particles", "missing required"});
+                 {"drop.toml: particles: missing required table [particles]; allowed: an array of "
+                  "tables [[particles]], each with position ([x, y]), diameter, and optionally "
+                  "velocity, angular_velocity, density, material"});
 }
 
 TEST(SceneConfig, AMillCommandRefusesASceneClearly) {
