@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <sys/wait.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -69,7 +70,57 @@ void expect_refused(std::string_view text, std::initializer_list<std::string> ov
   }
 }
 
+/// The first ```toml block of README.md's "Scenes" section, as the reader sees it; empty if the
+/// README or the block is not found.
+std::string readme_scene_example() {
+  std::ifstream file(std::filesystem::path(MILLSIM_SOURCE_DIR) / "README.md");
+  const std::string readme((std::istreambuf_iterator<char>(file)), {});
+  const std::size_t section = readme.find("\n## Scenes");
+  if (section == std::string::npos) return {};
+  const std::string open = "\n```toml\n";
+  const std::size_t start = readme.find(open, section);
+  if (start == std::string::npos) return {};
+  const std::size_t end = readme.find("\n```\n", start + open.size());
+  if (end == std::string::npos) return {};
+  // Inside the section, not a later one's block.
+  if (readme.find("\n## ", section + 1) < start) return {};
+  return readme.substr(start + open.size(), end + 1 - start - open.size());
+}
+
 TEST(SceneConfig, ReadsTheExampleOfTheReadme) {
+  // Read from README.md itself, so that the example and this test cannot drift apart.
+  const std::string example = readme_scene_example();
+  ASSERT_NE(example.find("[[particles]]"), std::string::npos)
+      << "no ```toml block with [[particles]] in README.md's \"Scenes\" section";
+  const SceneConfig c = scene(example);
+  EXPECT_EQ(c.dimension, 3);
+  ASSERT_TRUE(c.time_step.has_value());
+  EXPECT_EQ(*c.time_step, 1e-6);
+  EXPECT_EQ(c.duration, 0.01);
+  EXPECT_EQ(c.gravity, (std::array<double, 3>{0.0, 0.0, -9.81}));
+  ASSERT_EQ(c.particles.size(), 1u);
+  EXPECT_EQ(c.particles[0].position, (std::array<double, 3>{0.0, 0.0, 0.0105}));
+  EXPECT_EQ(c.particles[0].velocity, (std::array<double, 3>{3.0, 0.0, -2.0}));
+  EXPECT_EQ(c.particles[0].angular_velocity, (std::array<double, 3>{0.0, 0.0, 0.0}));
+  EXPECT_EQ(c.particles[0].diameter, 0.02);
+  EXPECT_EQ(c.particles[0].density, 4000.0);
+  ASSERT_EQ(c.walls.size(), 1u);
+  EXPECT_EQ(c.walls[0].point, (std::array<double, 3>{0.0, 0.0, 0.0}));
+  EXPECT_EQ(c.walls[0].normal, (std::array<double, 3>{0.0, 0.0, 1.0}));
+  // The empty material tables leave the defaults: k_n = 4e5 N/m, k_s = 2/3 of it.
+  EXPECT_EQ(c.ball_ball.normal_stiffness, 4e5);
+  EXPECT_EQ(c.ball_wall.normal_stiffness, 4e5);
+  EXPECT_DOUBLE_EQ(c.ball_wall.tangential_stiffness, 2.0 / 3.0 * 4e5);
+  EXPECT_EQ(c.output_directory, "out");
+  EXPECT_EQ(c.trajectory_interval, 1e-5);
+  // 0.01 s in steps of 1e-6 s: 10 000 steps; a trajectory row every 1e-5/1e-6 = 10 steps.
+  const millsim::ScenePlan plan = millsim::plan_scene(c);
+  EXPECT_EQ(plan.steps, 10000);
+  EXPECT_EQ(plan.trajectory_every, 10);
+}
+
+TEST(SceneConfig, ReadsTheDropTestOfTheseTests) {
+  // `drop`, the README's example with a stiffer wall and a normal of length 2.
   const SceneConfig c = scene(drop);
   EXPECT_EQ(c.dimension, 3);
   ASSERT_EQ(c.particles.size(), 1u);
