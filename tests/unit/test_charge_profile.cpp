@@ -71,7 +71,15 @@ TEST(ChargeProfile, BallsOnLifterTopsAreInTheLinerLayerAndTheRowInsideThemIsNot)
   EXPECT_EQ(profile.mean_count(ChargeProfile::bins / 2), 0.0);
 }
 
-TEST(ChargeProfile, EdgesBetweenBinsAreInterpolatedToWithinHalfABin) {
+TEST(ChargeProfile, EdgesBetweenBinsAreInterpolatedLinearlyBetweenBinCentres) {
+  // Balls at 233.5°, 234.5°, …, 386.5° (= 26.5°), one a degree; bins are 5° wide.
+  //   Toe side: bin 230–235° holds 2 (233.5°, 234.5°), bin 235–240° holds 5; the fullest
+  //   count is 5, so half = 2.5, and the crossing lies from the centre of the inside bin
+  //   (237.5°) towards the outside one (232.5°) by the fraction (5 − 2.5)/(5 − 2) = 5/6:
+  //   toe = 237.5° − 5/6 × 5° = 237.5° − 25/6° = 233⅓°.
+  //   Shoulder side: bin 20–25° holds 5, bin 25–30° holds 2 (25.5°, 26.5°); same fraction:
+  //   shoulder = 22.5° + 25/6° = 26⅔°.
+  // Rounding to a bin boundary (fraction ½) would give 235° and 25°.
   Charge charge;
   charge.arc(233.0, 27.0, shell - ball);
   // A few balls in flight pass the layer at the toe's impacts: too few to move the toe.
@@ -83,8 +91,8 @@ TEST(ChargeProfile, EdgesBetweenBinsAreInterpolatedToWithinHalfABin) {
   profile.add<2>(charge.position, charge.radius);
   const auto ends = profile.toe_and_shoulder();
   ASSERT_TRUE(ends.has_value());
-  EXPECT_NEAR(ends->toe, 233.0 * degree, 2.5 * degree);
-  EXPECT_NEAR(ends->shoulder, 27.0 * degree, 2.5 * degree);
+  EXPECT_NEAR(ends->toe, (237.5 - 25.0 / 6.0) * degree, 1e-9);
+  EXPECT_NEAR(ends->shoulder, (22.5 + 25.0 / 6.0) * degree, 1e-9);
 }
 
 TEST(ChargeProfile, AShoulderBelowTheHorizontalIsNegative) {

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <iterator>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -115,18 +116,52 @@ TEST_F(Cli, VersionPrintsTheVersionAndTheSourceRevision) {
   const Outcome o = millsim("--version");
   EXPECT_EQ(o.status, 0) << o.err;
   EXPECT_EQ(o.out, "millsim " + millsim::version_text() + "\n");
-  EXPECT_TRUE(o.out.starts_with("millsim 0.1.0 (")) << o.out;
+  // The revision is cmake/version.cmake's `git describe --always --dirty --abbrev=12` of the
+  // source directory at build time: in a checkout without tags, 12 hex digits of the commit
+  // and "-dirty" if the tree had changes; "unknown" when the source is not a git checkout (or git
+  // is missing), as README.md says.
+  const std::regex from_git(R"(millsim 0\.1\.0 \(([0-9a-f]{12})(-dirty)?\)\n)");
+  const std::regex outside_git(R"(millsim 0\.1\.0 \(unknown\)\n)");
+  const fs::path source(MILLSIM_SOURCE_DIR);
+  // The test asks git the same question version.cmake asks: is there a checkout it can read?
+  const bool checkout =
+      fs::exists(source / ".git") &&
+      std::system(
+          ("git -C " + quoted(source.string()) + " rev-parse HEAD >/dev/null 2>&1").c_str()) == 0;
+  std::smatch match;
+  if (checkout) {
+    ASSERT_TRUE(std::regex_match(o.out, match, from_git)) << o.out;
+    // And the digits name a commit of this checkout, not any 12 hex digits.
+    EXPECT_EQ(std::system(("git -C " + quoted(source.string()) + " cat-file -e " + match[1].str() +
+                           "^{commit} 2>/dev/null")
+                              .c_str()),
+              0)
+        << match[1] << " is not a commit of " << source;
+  } else {
+    EXPECT_TRUE(std::regex_match(o.out, outside_git) || std::regex_match(o.out, from_git)) << o.out;
+  }
 }
 
 TEST_F(Cli, RefusesATimeStepAboveTheStabilityLimitAndGivesTheLimit) {
+  // The limit of docs/model.md ("Time step"), 2/ω_max, for base_config: 2D discs of 0.0508 m
+  // and 7800 kg/m³, weighed as spheres, m = 4/3 π 0.0254³ × 7800 = 0.53540739 kg; default
+  // materials k_n = 4e5 N/m and k_s = 2/3 k_n = 266 667 N/m for both ball–ball and ball–wall.
+  // Discs (I = m r²/2) add 1/m + 2/m each to 1/m_t:
+  //   disc–disc: m* = m/2, ω_n = sqrt(4e5/0.26770) = 1222.4 s⁻¹; m_t = m/6,
+  //              ω_t = sqrt(266 667 × 6/0.53540739) = 1728.69 s⁻¹;
+  //   disc–wall: m* = m, ω_n = 864.3 s⁻¹; m_t = m/3, ω_t = 1222.4 s⁻¹.
+  // ω_max = 1728.69 s⁻¹, limit 2/1728.69 = 1.15694e-3 s, printed with 4 digits as 0.001157.
+  const std::string limit = "0.001157";
   const std::string text = with(base_config, "time_step", "time_step = 0.01");
   const Outcome o = run_config(text, tiny_run);
   expect_refused(o, {at_line(text, "time_step"), "simulation.time_step", "0.01 s is unstable",
-                     "stability limit is 0.00", "\"auto\""});
+                     "(the stability limit is " + limit + " s;",
+                     "allowed: \"auto\" or a number of seconds below " + limit + "\n"});
   // The same from the command line.
   expect_refused(run_config(base_config, "--set simulation.time_step=0.01"),
                  {"command line (--set simulation.time_step=0.01)", "simulation.time_step",
-                  "stability limit is 0.00"});
+                  "(the stability limit is " + limit + " s;",
+                  "allowed: \"auto\" or a number of seconds below " + limit + "\n"});
 }
 
 TEST_F(Cli, RefusesATomlSyntaxErrorWithFileAndLine) {

@@ -8,6 +8,7 @@
 #include <iterator>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 
 #include "millsim/io/partial_file.hpp"
 
@@ -86,9 +87,18 @@ TEST_F(PartialFileTest, ARenameThatFailsLeavesNothingAndSaysSo) {
   // The final name is taken by a directory that is not empty: the rename fails, and the
   // .partial goes too.
   fs::create_directories(directory_ / "impacts.csv" / "inside");
-  millsim::PartialFile file(directory_ / "impacts.csv");
+  const fs::path path = directory_ / "impacts.csv";
+  millsim::PartialFile file(path);
   file.write("angle_rad,count\n");
-  EXPECT_THROW(file.commit(), std::runtime_error);
+  // The message names the file and the system's reason: rename(2) of a file onto a directory
+  // fails with EISDIR.
+  try {
+    file.commit();
+    ADD_FAILURE() << "committed onto a directory";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path.string() + ": write failed: " +
+                                         std::make_error_code(std::errc::is_a_directory).message());
+  }
   EXPECT_EQ(listing(), "impacts.csv;");
   EXPECT_TRUE(fs::is_directory(directory_ / "impacts.csv"));
   EXPECT_THROW(file.commit(), std::logic_error);

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <sys/wait.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -69,7 +70,57 @@ void expect_refused(std::string_view text, std::initializer_list<std::string> ov
   }
 }
 
+/// The first ```toml block of README.md's "Scenes" section, as the reader sees it; empty if the
+/// README or the block is not found.
+std::string readme_scene_example() {
+  std::ifstream file(std::filesystem::path(MILLSIM_SOURCE_DIR) / "README.md");
+  const std::string readme((std::istreambuf_iterator<char>(file)), {});
+  const std::size_t section = readme.find("\n## Scenes");
+  if (section == std::string::npos) return {};
+  const std::string open = "\n```toml\n";
+  const std::size_t start = readme.find(open, section);
+  if (start == std::string::npos) return {};
+  const std::size_t end = readme.find("\n```\n", start + open.size());
+  if (end == std::string::npos) return {};
+  // Inside the section, not a later one's block.
+  if (readme.find("\n## ", section + 1) < start) return {};
+  return readme.substr(start + open.size(), end + 1 - start - open.size());
+}
+
 TEST(SceneConfig, ReadsTheExampleOfTheReadme) {
+  // Read from README.md itself, so that the example and this test cannot drift apart.
+  const std::string example = readme_scene_example();
+  ASSERT_NE(example.find("[[particles]]"), std::string::npos)
+      << "no ```toml block with [[particles]] in README.md's \"Scenes\" section";
+  const SceneConfig c = scene(example);
+  EXPECT_EQ(c.dimension, 3);
+  ASSERT_TRUE(c.time_step.has_value());
+  EXPECT_EQ(*c.time_step, 1e-6);
+  EXPECT_EQ(c.duration, 0.01);
+  EXPECT_EQ(c.gravity, (std::array<double, 3>{0.0, 0.0, -9.81}));
+  ASSERT_EQ(c.particles.size(), 1u);
+  EXPECT_EQ(c.particles[0].position, (std::array<double, 3>{0.0, 0.0, 0.0105}));
+  EXPECT_EQ(c.particles[0].velocity, (std::array<double, 3>{3.0, 0.0, -2.0}));
+  EXPECT_EQ(c.particles[0].angular_velocity, (std::array<double, 3>{0.0, 0.0, 0.0}));
+  EXPECT_EQ(c.particles[0].diameter, 0.02);
+  EXPECT_EQ(c.particles[0].density, 4000.0);
+  ASSERT_EQ(c.walls.size(), 1u);
+  EXPECT_EQ(c.walls[0].point, (std::array<double, 3>{0.0, 0.0, 0.0}));
+  EXPECT_EQ(c.walls[0].normal, (std::array<double, 3>{0.0, 0.0, 1.0}));
+  // The empty material tables leave the defaults: k_n = 4e5 N/m, k_s = 2/3 of it.
+  EXPECT_EQ(c.ball_ball.normal_stiffness, 4e5);
+  EXPECT_EQ(c.ball_wall.normal_stiffness, 4e5);
+  EXPECT_DOUBLE_EQ(c.ball_wall.tangential_stiffness, 2.0 / 3.0 * 4e5);
+  EXPECT_EQ(c.output_directory, "out");
+  EXPECT_EQ(c.trajectory_interval, 1e-5);
+  // 0.01 s in steps of 1e-6 s: 10 000 steps; a trajectory row every 1e-5/1e-6 = 10 steps.
+  const millsim::ScenePlan plan = millsim::plan_scene(c);
+  EXPECT_EQ(plan.steps, 10000);
+  EXPECT_EQ(plan.trajectory_every, 10);
+}
+
+TEST(SceneConfig, ReadsTheDropTestOfTheseTests) {
+  // `drop`, the README's example with a stiffer wall and a normal of length 2.
   const SceneConfig c = scene(drop);
   EXPECT_EQ(c.dimension, 3);
   ASSERT_EQ(c.particles.size(), 1u);
@@ -132,8 +183,18 @@ TEST(SceneConfig, WarnsOfAGivenTimeStepCoarserThanATenthOfTheShortestContact) {
 }
 
 TEST(SceneConfig, RefusesAnUnstableTimeStepAndGivesTheLimit) {
+  // The limit of docs/model.md ("Time step"), 2/ω_max, for drop's one sphere on its wall:
+  // m = 4000 π/6 0.02³ = 0.016755161 kg (m* = m against a wall); ball–wall k_n = 1e6 N/m and
+  // the default k_s = 2/3 k_n = 666 667 N/m. A sphere (I = 2/5 m r²) adds 1/m + 5/2 m to 1/m_t:
+  // m_t = 2m/7 = 4.7872e-3 kg. ω_n = sqrt(1e6/m) = 7725.5 s⁻¹, ω_t = sqrt(666 667/4.7872e-3) =
+  // 11 801 s⁻¹, the larger: limit 2/11 801 = 1.69479e-4 s, printed with 4 digits as 0.0001695.
+  // The shortest contact is AutoTimeStepIsATwentiethOfTheShortestContact's t_c = 4.1199387e-4 s
+  // (0.000412), and 1/20 of it 2.0599693e-5 s (2.06e-05).
   expect_refused(drop, {"simulation.time_step=1e-3"},
-                 {"simulation.time_step", "unstable", "stability limit"});
+                 {"command line (--set simulation.time_step=1e-3): simulation.time_step: 0.001 s "
+                  "is unstable for these particles and materials (the shortest contact lasts "
+                  "0.000412 s); allowed: a time step below the stability limit 0.0001695 s, and "
+                  "for accuracy about 2.06e-05 s (1/20 of the contact), or \"auto\""});
 }
 
 TEST(SceneConfig, RefusesAMillKeyInAScene) {
@@ -198,8 +259,13 @@ TEST(SceneConfig, RefusesParticlesThatOverlapAtTheStart) {
 }
 
 TEST(SceneConfig, RefusesAConfigWithoutParticlesOrMill) {
+  // Walls without a mill make a scene: the refusal is the scene reader's missing [[particles]],
+  // not parse_config's "missing required table [mill], and no [[particles]] either" (which also
+  // holds "particles" and "missing required").
   expect_refused("[simulation]\nduration = 1\n[[walls]]\npoint = [0, 0]\nnormal = [0, 1]\n", {},
-                 {"particles", "missing required"});
+                 {"drop.toml: particles: missing required table [particles]; allowed: an array of "
+                  "tables [[particles]], each with position ([x, y]), diameter, and optionally "
+                  "velocity, angular_velocity, density, material"});
 }
 
 TEST(SceneConfig, AMillCommandRefusesASceneClearly) {
