@@ -721,6 +721,44 @@ TEST_F(Cli, ValidateReadsEveryCaseBeforeRunningAnyAndShowsAMissingPaperFigureAsN
   b >> name >> measured >> paper >> predicted >> error >> paper_error;
   EXPECT_EQ(paper, "0.62") << good.out;
   EXPECT_EQ(paper_error, "+3.3") << good.out;
+  // The same table in runs/validation.csv, with the summaries' names and full numbers: each
+  // power as its summary.json has it, the errors relative, an empty cell for no paper figure.
+  const auto power_of = [&](std::string_view case_name) {
+    const std::string json = read_all(work_ / "runs" / case_name / "summary.json");
+    const auto at = json.find("\"power_kw\" : ");
+    EXPECT_NE(at, std::string::npos) << json;
+    return std::stod(json.substr(at + 13));
+  };
+  std::istringstream table(read_all(work_ / "runs" / "validation.csv"));
+  std::string line;
+  std::getline(table, line);
+  EXPECT_EQ(line,
+            "case,measured_power_kw,paper_power_kw,power_kw,error,paper_error,tolerance,within");
+  std::size_t outside_in_file = 0;
+  for (const std::string case_name : {"a", "b"}) {
+    ASSERT_TRUE(std::getline(table, line));
+    std::vector<std::string> cells;
+    std::istringstream row(line + ",");
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    ASSERT_EQ(cells.size(), 8U) << line;
+    EXPECT_EQ(cells[0], case_name);
+    EXPECT_EQ(cells[1], "0.6");
+    const double power = power_of(case_name);
+    EXPECT_EQ(std::stod(cells[3]), power) << line;
+    EXPECT_EQ(std::stod(cells[4]), (power - 0.6) / 0.6) << line;
+    EXPECT_EQ(cells[6], "0.15");
+    EXPECT_EQ(cells[7], std::abs(power - 0.6) <= 0.15 * 0.6 ? "yes" : "no") << line;
+    outside_in_file += cells[7] == "no" ? 1 : 0;
+    if (case_name == "a") {
+      EXPECT_EQ(cells[2], "");
+      EXPECT_EQ(cells[5], "");
+    } else {
+      EXPECT_EQ(cells[2], "0.62");
+      EXPECT_EQ(std::stod(cells[5]), (0.62 - 0.6) / 0.6);
+    }
+  }
+  EXPECT_FALSE(std::getline(table, line)) << line;
+  EXPECT_EQ(outside_in_file, outside);
   // validate places each case under --out itself: a --set of the directory is refused.
   const Outcome set = millsim(std::string("validate cases -q -o runs2 ") + tiny_run +
                               " --set output.directory=elsewhere");
