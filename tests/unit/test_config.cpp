@@ -7,6 +7,7 @@
 #include <initializer_list>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "millsim/core/error.hpp"
@@ -527,6 +528,30 @@ TEST(Config, AnOverrideOfOneOfTwoAlternativeKeysReplacesTheFilesOther) {
   // Two alternatives in the file are refused as before, whatever else is set.
   const std::string both = with(base_config, "speed", "speed = 0.5\nspeed_rpm = 20");
   expect_has(error_of(both, {"mill.length=0.2"}), {at_line(both, "speed_rpm"), "not both"});
+}
+
+TEST(Config, ReadsTheSnapshotFormatAndRefusesAnyOther) {
+  const MillConfig plain = parse_mill_config(base_config, file_name);
+  EXPECT_TRUE(plain.snapshot_csv);
+  EXPECT_FALSE(plain.snapshot_vtk);
+  const auto formats = [](const std::string& format) {
+    const MillConfig c =
+        parse_mill_config(with(base_config, "snapshot_interval",
+                               "snapshot_interval = 0.05\nsnapshot_format = \"" + format + "\""),
+                          file_name);
+    return std::pair{c.snapshot_csv, c.snapshot_vtk};
+  };
+  EXPECT_EQ(formats("csv"), std::pair(true, false));
+  EXPECT_EQ(formats("vtk"), std::pair(false, true));
+  EXPECT_EQ(formats("both"), std::pair(true, true));
+  const std::string text =
+      with(base_config, "snapshot_interval", "snapshot_interval = 0.05\nsnapshot_format = \"VTK\"");
+  expect_has(error_of(text),
+             {at_line(text, "snapshot_format"),
+              "output.snapshot_format: \"VTK\" is not a snapshot format; allowed: \"csv\" (a "
+              "table a snapshot), \"vtk\" (VTK files and a ParaView collection) or \"both\""});
+  expect_has(error_of(base_config, {"output.snapshot_format=\"vtp\""}),
+             {"command line (--set output.snapshot_format=\"vtp\")", "\"vtp\" is not a snapshot"});
 }
 
 TEST(Config, RefusesANulInTheOutputPath) {

@@ -50,7 +50,7 @@ const std::vector<KnownTable>& known_tables() {
       {"materials", {"ball_ball", "ball_wall"}},
       {"materials.ball_ball] or [materials.ball_wall",
        {"normal_stiffness", "tangential_stiffness", "restitution", "friction"}},
-      {"output", {"directory", "snapshot_interval"}},
+      {"output", {"directory", "snapshot_interval", "snapshot_format"}},
       {"reference", {"case", "measured_power_kw", "paper_power_kw", "tolerance"}},
   };
   return tables;
@@ -376,11 +376,20 @@ std::string read_output_directory(TableReader& section) {
 namespace {
 
 void read_output(TableReader section, MillConfig& config) {
-  section.allow_keys({"directory", "snapshot_interval"}, belongs_elsewhere);
+  section.allow_keys({"directory", "snapshot_interval", "snapshot_format"}, belongs_elsewhere);
   config.output_directory = read_output_directory(section);
   config.snapshot_interval =
       section.number("snapshot_interval", 0.05, "a number of seconds >= 0 (0 = no snapshots)",
                      [](double t) { return t >= 0.0; });
+  constexpr std::string_view format_rule =
+      "\"csv\" (a table a snapshot), \"vtk\" (VTK files and a ParaView collection) or \"both\"";
+  const std::string format = section.string("snapshot_format", "csv", format_rule);
+  if (format != "csv" && format != "vtk" && format != "both") {
+    section.fail_at("snapshot_format", fmt::format("\"{}\" is not a snapshot format; allowed: {}",
+                                                   format, format_rule));
+  }
+  config.snapshot_csv = format != "vtk";
+  config.snapshot_vtk = format != "csv";
 }
 
 void read_reference(TableReader section, MillConfig& config) {

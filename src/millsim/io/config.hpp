@@ -66,6 +66,8 @@ struct MillConfig {
   // [output]
   std::string output_directory = "out";
   double snapshot_interval = 0.05;  ///< s; 0 = none
+  bool snapshot_csv = true;         ///< output.snapshot_format "csv" or "both"
+  bool snapshot_vtk = false;        ///< output.snapshot_format "vtk" or "both"
 
   std::optional<ReferencePower> reference;
 

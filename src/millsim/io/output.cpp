@@ -251,8 +251,8 @@ void write_particles(PartialFile& out, const World<2>& world) {
 
 }  // namespace
 
-SnapshotWriter::SnapshotWriter(std::filesystem::path directory)
-    : directory_(std::move(directory)) {}
+SnapshotWriter::SnapshotWriter(std::filesystem::path directory, bool csv, bool vtk)
+    : directory_(std::move(directory)), csv_(csv), vtk_(vtk) {}
 
 SnapshotWriter::~SnapshotWriter() {
   if (index_ != nullptr) std::fclose(index_);
@@ -260,17 +260,32 @@ SnapshotWriter::~SnapshotWriter() {
 
 template <int D>
 void SnapshotWriter::write(const World<D>& world) {
-  const std::string name = fmt::format("snapshot_{:06d}.csv", count_);
-  PartialFile out(directory_ / name);
-  write_particles(out, world);
-  out.commit();
+  const std::string stem = fmt::format("snapshot_{:06d}", count_);
+  if (csv_) {
+    PartialFile out(directory_ / (stem + ".csv"));
+    write_particles(out, world);
+    out.commit();
+  }
+  if (vtk_) {
+    const std::string mill = fmt::format("mill_{:06d}.vtp", count_);
+    write_whole_file(directory_ / (stem + ".vtp"), particles_vtp(world));
+    write_whole_file(directory_ / mill, mill_vtp(world));
+    if (!particle_collection_) {
+      particle_collection_ = std::make_unique<PvdCollection>(directory_ / "particles.pvd");
+      mill_collection_ = std::make_unique<PvdCollection>(directory_ / "mill.pvd");
+    }
+    particle_collection_->add(world.time(), {stem + ".vtp"});
+    mill_collection_->add(world.time(), {mill});
+  }
+  const std::string name = stem + (csv_ ? ".csv" : ".vtp");
   // The index gets the snapshot's row once the snapshot is whole, so that every file it names
   // is complete; rows are appended and flushed one by one.
   const std::filesystem::path index_path = directory_ / "index.csv";
   if (index_ == nullptr) {
     index_ = std::fopen(index_path.c_str(), "wb");
-    if (index_ == nullptr)
+    if (index_ == nullptr) {
       throw std::runtime_error(fmt::format("{}: cannot write", index_path.string()));
+    }
     std::fputs("snapshot,file,time_s,shell_angle_rad\n", index_);
   }
   fmt::print(index_, "{},{},{},{}\n", count_, name, world.time(),

@@ -3,24 +3,28 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "millsim/io/vtk_output.hpp"
 #include "millsim/sim/world.hpp"
 
 namespace millsim {
 
 struct MillResult;
 
-/// The snapshots of a run (README "Outputs"), in the directory given: snapshot_NNNNNN.csv, one
-/// a call of write, with a row for each particle in the order of their ids (World's
+/// The snapshots of a run (README "Outputs"), in the directory given. As CSV: snapshot_NNNNNN.csv,
+/// one a call of write, with a row for each particle in the order of their ids (World's
 /// particle_id): id, position, velocity and angular velocity at the time of the positions,
-/// radius and net force; and index.csv, a row for each snapshot written: its number, file,
-/// time and the shell's angle. Errors throw std::runtime_error naming the file.
+/// radius and net force. For ParaView (vtk_output.hpp): snapshot_NNNNNN.vtp (the particles),
+/// mill_NNNNNN.vtp (the walls), and particles.pvd and mill.pvd listing each by time. Either way
+/// index.csv, a row for each snapshot written: its number, its particles' file, its time and the
+/// shell's angle. Errors throw std::runtime_error naming the file.
 class SnapshotWriter {
  public:
-  explicit SnapshotWriter(std::filesystem::path directory);
+  SnapshotWriter(std::filesystem::path directory, bool csv = true, bool vtk = false);
   ~SnapshotWriter();
   SnapshotWriter(const SnapshotWriter&) = delete;
   SnapshotWriter& operator=(const SnapshotWriter&) = delete;
@@ -30,8 +34,13 @@ class SnapshotWriter {
 
  private:
   std::filesystem::path directory_;
+  bool csv_ = true;
+  bool vtk_ = false;
   int count_ = 0;
   std::FILE* index_ = nullptr;  // index.csv, open from the first snapshot on
+  // particles.pvd and mill.pvd, from the first snapshot on, if vtk_
+  std::unique_ptr<PvdCollection> particle_collection_;
+  std::unique_ptr<PvdCollection> mill_collection_;
 };
 
 extern template void SnapshotWriter::write(const World<2>&);

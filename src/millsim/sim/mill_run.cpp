@@ -78,7 +78,7 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
   const double series_angle = 2.0 * pi / 50.0;
 
   double next_snapshot = 0.0;
-  SnapshotWriter snapshots(snapshot_directory);
+  SnapshotWriter snapshots(snapshot_directory, plan.config.snapshot_csv, plan.config.snapshot_vtk);
   const auto write_snapshot_if_due = [&] {
     if (snapshot_interval <= 0.0 || world.time() + 0.5 * dt < next_snapshot) return;
     snapshots.write(world);

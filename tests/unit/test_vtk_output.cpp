@@ -1,0 +1,282 @@
+// Snapshots for ParaView (io/vtk_output.hpp): the particles' file reads back to the World's
+// values, the mill's walls lie where the contact geometry has them, and the collection is a
+// whole file after every snapshot.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "millsim/builtin_example.hpp"
+#include "millsim/core/constants.hpp"
+#include "millsim/io/config.hpp"
+#include "millsim/io/output.hpp"
+#include "millsim/io/vtk_output.hpp"
+#include "millsim/sim/charge.hpp"
+#include "support/program_test.hpp"
+
+namespace millsim {
+namespace {
+
+using testing::read_all;
+
+/// The built-in example mill with `overrides`, placed and stepped `steps` times, its
+/// particles renumbered into cell order at every rebuild (so that ids and indices differ).
+template <int D>
+World<D> example_world(std::vector<std::string> overrides, int steps) {
+  overrides.push_back("output.snapshot_interval=0");
+  const MillPlan plan =
+      plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", overrides));
+  World<D> world = build_mill_world<D>(plan);
+  world.set_cell_order_interval(1);
+  for (int n = 0; n < steps; ++n) world.step();
+  return world;
+}
+
+/// The numbers of the data array whose opening tag holds `attribute` (e.g. `Name="radius"`,
+/// or `NumberOfComponents="3" format` for the points', which have no name); a test failure,
+/// and none, if there is no such array.
+std::vector<double> array_of(std::string_view file, std::string_view attribute) {
+  std::size_t at = 0;
+  while ((at = file.find("<DataArray", at)) != std::string_view::npos) {
+    const std::size_t tag_end = file.find('>', at);
+    const std::string_view tag = file.substr(at, tag_end - at);
+    at = tag_end;
+    if (tag.find(attribute) == std::string_view::npos) continue;
+    if (attribute.find("Name") == std::string_view::npos &&
+        tag.find("Name=") != std::string_view::npos) {
+      continue;
+    }
+    const std::size_t end = file.find("</DataArray>", tag_end);
+    std::istringstream numbers(std::string(file.substr(tag_end + 1, end - tag_end - 1)));
+    std::vector<double> values;
+    for (std::string word; numbers >> word;) values.push_back(std::stod(word));
+    return values;
+  }
+  ADD_FAILURE() << "no data array with " << attribute;
+  return {};
+}
+
+/// The value of `attribute` (e.g. NumberOfPolys) in the file's Piece tag.
+long piece_count(std::string_view file, std::string_view attribute) {
+  const std::size_t piece = file.find("<Piece");
+  const std::size_t at = file.find(std::string(attribute) + "=\"", piece);
+  if (piece == std::string_view::npos || at == std::string_view::npos) {
+    ADD_FAILURE() << "no " << attribute;
+    return -1;
+  }
+  return std::stol(std::string(file.substr(at + attribute.size() + 2)));
+}
+
+TEST(VtkOutput, ParticlesReadBackToTheWorldsValuesById) {
+  const World<3> world = example_world<3>({"simulation.dimension=3"}, 300);
+  const std::string file = particles_vtp(world);
+  const std::size_t n = world.particles().size();
+  ASSERT_GT(n, 100U);
+  EXPECT_TRUE(file.starts_with("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\""));
+  EXPECT_TRUE(file.ends_with("</Piece>\n  </PolyData>\n</VTKFile>\n"));
+  EXPECT_EQ(piece_count(file, "NumberOfPoints"), static_cast<long>(n));
+  EXPECT_EQ(piece_count(file, "NumberOfVerts"), static_cast<long>(n));
+  const std::vector<double> id = array_of(file, "Name=\"id\"");
+  const std::vector<double> radius = array_of(file, "Name=\"radius\"");
+  const std::vector<double> velocity = array_of(file, "Name=\"velocity\"");
+  const std::vector<double> spin = array_of(file, "Name=\"angular_velocity\"");
+  const std::vector<double> force = array_of(file, "Name=\"force\"");
+  const std::vector<double> points = array_of(file, "NumberOfComponents=\"3\" format");
+  const std::vector<double> connectivity = array_of(file, "Name=\"connectivity\"");
+  const std::vector<double> offsets = array_of(file, "Name=\"offsets\"");
+  ASSERT_EQ(id.size(), n);
+  ASSERT_EQ(radius.size(), n);
+  ASSERT_EQ(velocity.size(), 3 * n);
+  ASSERT_EQ(spin.size(), 3 * n);
+  ASSERT_EQ(force.size(), 3 * n);
+  ASSERT_EQ(points.size(), 3 * n);
+  ASSERT_EQ(connectivity.size(), n);
+  ASSERT_EQ(offsets.size(), n);
+  const ParticleStore<3>& p = world.particles();
+  std::size_t renumbered = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = world.particle_index(k);
+    renumbered += i != k ? 1 : 0;
+    const auto [v, w] = motion_at_positions(world, i);
+    EXPECT_EQ(id[k], static_cast<double>(k));
+    EXPECT_EQ(connectivity[k], static_cast<double>(k));
+    EXPECT_EQ(offsets[k], static_cast<double>(k + 1));
+    EXPECT_EQ(radius[k], p.radius[i]);
+    for (int c = 0; c < 3; ++c) {
+      const std::size_t at = 3 * k + static_cast<std::size_t>(c);
+      EXPECT_EQ(points[at], p.position[i][c]) << "particle " << k;
+      EXPECT_EQ(velocity[at], v[c]) << "particle " << k;
+      EXPECT_EQ(spin[at], w[c]) << "particle " << k;
+      EXPECT_EQ(force[at], p.force[i][c]) << "particle " << k;
+    }
+  }
+  EXPECT_GT(renumbered, 0U) << "the test should see particles listed by id, not by index";
+}
+
+TEST(VtkOutput, TwoDimensionalParticlesLieInThePlaneAndSpinAboutZ) {
+  const World<2> world = example_world<2>({}, 300);
+  const std::string file = particles_vtp(world);
+  const std::vector<double> points = array_of(file, "NumberOfComponents=\"3\" format");
+  const std::vector<double> spin = array_of(file, "Name=\"angular_velocity\"");
+  const std::size_t n = world.particles().size();
+  ASSERT_EQ(points.size(), 3 * n);
+  ASSERT_EQ(spin.size(), 3 * n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = world.particle_index(k);
+    EXPECT_EQ(points[3 * k], world.particles().position[i][0]);
+    EXPECT_EQ(points[3 * k + 1], world.particles().position[i][1]);
+    EXPECT_EQ(points[3 * k + 2], 0.0);
+    EXPECT_EQ(spin[3 * k], 0.0);
+    EXPECT_EQ(spin[3 * k + 1], 0.0);
+    EXPECT_EQ(spin[3 * k + 2], motion_at_positions(world, i).second);
+  }
+}
+
+TEST(VtkOutput, TwoDimensionalMillIsTheShellCircleAndTheLifterRectangles) {
+  // The built-in example: R = 0.45 m, 8 lifters 0.04 m high and wide; turned to 0.3 rad.
+  World<2> world = example_world<2>({}, 0);
+  world.walls().mill->turn_to(0.3);
+  const std::string file = mill_vtp(world);
+  const Mill2D& mill = *world.walls().mill;
+  ASSERT_EQ(mill.lifter_count, 8);
+  EXPECT_EQ(piece_count(file, "NumberOfLines"), 1);
+  EXPECT_EQ(piece_count(file, "NumberOfPolys"), 8);
+  const std::vector<double> points = array_of(file, "NumberOfComponents=\"3\" format");
+  ASSERT_EQ(points.size(), 3U * (shell_segments + 4 * 8));
+  for (int k = 0; k < shell_segments; ++k) {
+    const double* p = &points[3 * static_cast<std::size_t>(k)];
+    EXPECT_NEAR(std::hypot(p[0], p[1]), 0.45, 1e-15);
+    EXPECT_EQ(p[2], 0.0);
+  }
+  // Lifter j's corners: radial a = R − h or R, tangential b = ∓w/2, about the direction
+  // 0.3 + 2πj/8 (lifter 0 sits at the shell's angle).
+  for (int j = 0; j < 8; ++j) {
+    const double angle = 0.3 + 2.0 * pi * j / 8.0;
+    const double expected[4][2] = {{0.41, -0.02}, {0.45, -0.02}, {0.45, 0.02}, {0.41, 0.02}};
+    for (int c = 0; c < 4; ++c) {
+      const double* p = &points[3 * static_cast<std::size_t>(shell_segments + 4 * j + c)];
+      const double a = p[0] * std::cos(angle) + p[1] * std::sin(angle);
+      const double b = -p[0] * std::sin(angle) + p[1] * std::cos(angle);
+      EXPECT_NEAR(a, expected[c][0], 1e-15) << "lifter " << j << " corner " << c;
+      EXPECT_NEAR(b, expected[c][1], 1e-15) << "lifter " << j << " corner " << c;
+    }
+  }
+  // The wall of each cell: the shell's line, then the lifters.
+  const std::vector<double> wall = array_of(file, "Name=\"wall\"");
+  ASSERT_EQ(wall.size(), 9U);
+  EXPECT_EQ(wall[0], 0.0);
+  EXPECT_TRUE(std::all_of(wall.begin() + 1, wall.end(), [](double w) { return w == 1.0; }));
+  const std::vector<double> line = array_of(file, "Name=\"connectivity\"");
+  ASSERT_GE(line.size(), static_cast<std::size_t>(shell_segments + 1));
+  EXPECT_EQ(line[0], 0.0);
+  EXPECT_EQ(line[shell_segments], 0.0) << "the shell's line closes on its first point";
+}
+
+TEST(VtkOutput, ThreeDimensionalMillsHaveTheirEndsOrNone) {
+  const auto polys_of = [](const World<3>& world) {
+    return piece_count(mill_vtp(world), "NumberOfPolys");
+  };
+  // Flat ends: the shell's quadrilaterals, six faces a lifter, two end plates.
+  const World<3> flat = example_world<3>({"simulation.dimension=3"}, 0);
+  EXPECT_EQ(polys_of(flat), shell_segments + 6 * 8 + 2);
+  const std::string flat_file = mill_vtp(flat);
+  const std::vector<double> points = array_of(flat_file, "NumberOfComponents=\"3\" format");
+  ASSERT_GE(points.size(), 3U * 2 * shell_segments);
+  for (int k = 0; k < 2 * shell_segments; ++k) {
+    const double* p = &points[3 * static_cast<std::size_t>(k)];
+    EXPECT_NEAR(std::hypot(p[0], p[1]), 0.45, 1e-15);
+    EXPECT_EQ(p[2], k < shell_segments ? 0.0 : flat.walls().mill->length);
+  }
+  // A periodic slab has no ends.
+  const World<3> slab = example_world<3>(
+      {"simulation.dimension=3", "mill.length=0.9", "mill.periodic=true", "mill.slab_length=0.16"},
+      0);
+  EXPECT_EQ(polys_of(slab), shell_segments + 6 * 8);
+  // Conical ends: each a ring of quadrilaterals to the trunnion, closed there by a plate at
+  // r_t = R − c / tan α, c beyond the cylinder.
+  const World<3> cones = example_world<3>(
+      {"simulation.dimension=3", "mill.cone_angle=20", "mill.cone_length=0.05"}, 0);
+  EXPECT_EQ(polys_of(cones), 3 * shell_segments + 6 * 8 + 2);
+  const std::string cone_file = mill_vtp(cones);
+  const std::vector<double> cone_points = array_of(cone_file, "NumberOfComponents=\"3\" format");
+  const double trunnion = 0.45 - 0.05 / std::tan(20.0 * pi / 180.0);
+  const std::size_t first_trunnion = 2 * shell_segments + 8 * 8;
+  ASSERT_EQ(cone_points.size(), 3 * (first_trunnion + 2 * shell_segments));
+  for (std::size_t k = first_trunnion; k < first_trunnion + 2 * shell_segments; ++k) {
+    const double* p = &cone_points[3 * k];
+    EXPECT_NEAR(std::hypot(p[0], p[1]), trunnion, 1e-14);
+    EXPECT_EQ(p[2],
+              k < first_trunnion + shell_segments ? -0.05 : cones.walls().mill->length + 0.05);
+  }
+}
+
+/// A directory of its own under the system's temporary directory.
+std::filesystem::path fresh_directory() {
+  std::string pattern = (std::filesystem::temp_directory_path() / "millsim-vtk-XXXXXX").string();
+  EXPECT_NE(mkdtemp(pattern.data()), nullptr);
+  return pattern;
+}
+
+TEST(VtkOutput, TheCollectionIsWholeAfterEverySnapshot) {
+  const std::filesystem::path directory = fresh_directory();
+  const std::filesystem::path path = directory / "snapshots.pvd";
+  {
+    PvdCollection collection(path);
+    collection.add(0.0, {"snapshot_000000.vtp", "mill_000000.vtp"});
+    const std::string head =
+        "<?xml version=\"1.0\"?>\n"
+        "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+        "  <Collection>\n"
+        "    <DataSet timestep=\"0\" group=\"\" part=\"0\" file=\"snapshot_000000.vtp\"/>\n"
+        "    <DataSet timestep=\"0\" group=\"\" part=\"1\" file=\"mill_000000.vtp\"/>\n";
+    const std::string tail = "  </Collection>\n</VTKFile>\n";
+    EXPECT_EQ(read_all(path), head + tail);
+    collection.add(0.05, {"snapshot_000001.vtp", "mill_000001.vtp"});
+    EXPECT_EQ(read_all(path), head +
+                                  "    <DataSet timestep=\"0.05\" group=\"\" part=\"0\" "
+                                  "file=\"snapshot_000001.vtp\"/>\n"
+                                  "    <DataSet timestep=\"0.05\" group=\"\" part=\"1\" "
+                                  "file=\"mill_000001.vtp\"/>\n" +
+                                  tail);
+  }
+  std::filesystem::remove_all(directory);
+}
+
+TEST(VtkOutput, SnapshotsInVtkOnlyWriteNoTableAndTheIndexNamesTheirFiles) {
+  const std::filesystem::path directory = fresh_directory();
+  World<2> world = example_world<2>({}, 0);
+  {
+    SnapshotWriter snapshots(directory, false, true);
+    snapshots.write(world);
+    for (int n = 0; n < 10; ++n) world.step();
+    snapshots.write(world);
+  }
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(directory)) {
+    names.push_back(entry.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"index.csv", "mill.pvd", "mill_000000.vtp",
+                                             "mill_000001.vtp", "particles.pvd",
+                                             "snapshot_000000.vtp", "snapshot_000001.vtp"}));
+  EXPECT_NE(read_all(directory / "particles.pvd").find("part=\"0\" file=\"snapshot_000001.vtp\""),
+            std::string::npos);
+  EXPECT_NE(read_all(directory / "mill.pvd").find("part=\"0\" file=\"mill_000001.vtp\""),
+            std::string::npos);
+  const std::string index = read_all(directory / "index.csv");
+  EXPECT_TRUE(
+      index.starts_with("snapshot,file,time_s,shell_angle_rad\n0,snapshot_000000.vtp,0,0\n"
+                        "1,snapshot_000001.vtp,"))
+      << index;
+  std::filesystem::remove_all(directory);
+}
+
+}  // namespace
+}  // namespace millsim
