@@ -62,8 +62,14 @@ if [ "$mode" = speed ]; then
 else
   lift=${numbers[0]:-$lift}
   window=${numbers[1]:-$window}
-  # LIGGGHTS averages the torque over blocks of 100 steps (make_input.py), so the window is
-  # whole blocks; the lift may be 0 (the window then starts as the shell starts to turn).
+  # LIGGGHTS averages the torque over blocks of 100 steps counted from step 0 (make_input.py's
+  # fix ave/time), so the lift and the window are whole blocks: a lift of 150 would average
+  # half the window, one of 50 nothing. The lift may be 0 (the window then starts as the shell
+  # starts to turn).
+  if [ $((10#$lift % 100)) -ne 0 ]; then
+    echo "usage: $0 --power [LIFT [WINDOW]]: LIFT must be a multiple of 100 steps, not $lift" >&2
+    exit 2
+  fi
   if [ $((10#$window)) -eq 0 ] || [ $((10#$window % 100)) -ne 0 ]; then
     echo "usage: $0 --power [LIFT [WINDOW]]: WINDOW must be a positive multiple of 100 steps," \
       "not $window" >&2
