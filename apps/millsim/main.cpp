@@ -339,8 +339,24 @@ int validate_command(const std::string& directory, const JobOptions& options) {
       options.output_directory.empty()
           ? std::string("the default output directory (runs/validation)")
           : fmt::format("command line (--out {})", options.output_directory);
+  // The table's name, OUT/validation.csv, is checked before any case is read: a directory
+  // there would fail the validation only once every case had run.
+  const std::filesystem::path table_path = root / "validation.csv";
+  std::error_code unknown;
+  if (std::filesystem::is_directory(table_path, unknown)) {
+    throw millsim::InputError(fmt::format(
+        "{}: \"{}\" is a directory, where validate writes its table; allowed: an output "
+        "directory without a directory of that name (remove or rename it)",
+        root_location, table_path.string()));
+  }
   std::vector<MillPlan> plans;
   for (const auto& path : cases) {
+    if (path.stem() == table_path.filename()) {
+      throw millsim::InputError(fmt::format(
+          "{}: a case named {} would write its results where validate writes its table, {}; "
+          "allowed: any other name",
+          path.string(), path.stem().string(), table_path.string()));
+    }
     MillConfig config = millsim::load_mill_config(path.string(), options.overrides);
     if (!config.reference) {
       throw millsim::InputError(fmt::format(
@@ -365,16 +381,21 @@ int validate_command(const std::string& directory, const JobOptions& options) {
     std::optional<double> paper;
   };
   std::vector<Row> rows;
-  // The table of an earlier validation goes before any case runs: a validation that fails
-  // half-way leaves no table from another.
-  const std::filesystem::path table_path = root / "validation.csv";
-  for (const auto& stale : {table_path, std::filesystem::path(table_path.string() + ".partial")}) {
-    std::error_code ignored;
-    std::filesystem::remove(stale, ignored);
-  }
+  // The table of an earlier validation goes once the first case's directory is ready (a case
+  // refused there leaves it), before any case runs: a validation that fails half-way leaves no
+  // table from another.
+  bool earlier_table_removed = false;
   for (const MillPlan& plan : plans) {
     const MillConfig& config = plan.config;
     const auto started = [&] {
+      if (!earlier_table_removed) {
+        for (const auto& stale :
+             {table_path, std::filesystem::path(table_path.string() + ".partial")}) {
+          std::error_code ignored;
+          std::filesystem::remove(stale, ignored);
+        }
+        earlier_table_removed = true;
+      }
       if (!options.quiet) fmt::print(stderr, "running {} ...\n", config.source);
     };
     const MillResult result = config.dimension == 2
