@@ -2,6 +2,7 @@
 // its charge, and a running mill keeps its energy account (issue tests 5, 6, 7).
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <stdlib.h>
 
 #include <algorithm>
 #include <cmath>
@@ -162,9 +163,10 @@ TEST(Mill, SnapshotVelocitiesAreAtTheTimeOfThePositions) {
   // positions (the leapfrog's own) would miss both by g Δt / 2, 2e-4 m/s here.
   const MillPlan plan = plan_mill(lab_mill());
   World<2> world = build_mill_world<2>(plan);
-  const auto directory = std::filesystem::temp_directory_path() / "millsim-snapshot-motion";
-  std::filesystem::remove_all(directory);
-  std::filesystem::create_directories(directory);
+  std::string pattern =
+      (std::filesystem::temp_directory_path() / "millsim-snapshot-motion-XXXXXX").string();
+  ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+  const std::filesystem::path directory = pattern;
   {
     SnapshotWriter snapshots(directory);
     while (world.time() < 0.004) world.step();

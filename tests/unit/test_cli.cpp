@@ -117,10 +117,10 @@ TEST_F(Cli, VersionPrintsTheVersionAndTheSourceRevision) {
   EXPECT_EQ(o.status, 0) << o.err;
   EXPECT_EQ(o.out, "millsim " + millsim::version_text() + "\n");
   // The revision is cmake/version.cmake's `git describe --always --dirty --abbrev=12` of the
-  // source directory at build time: in a checkout without tags, 12 hex digits of the commit
-  // and "-dirty" if the tree had changes; "unknown" when the source is not a git checkout (or git
-  // is missing), as README.md says.
-  const std::regex from_git(R"(millsim 0\.1\.0 \(([0-9a-f]{12})(-dirty)?\)\n)");
+  // source directory at build time: at least 12 hex digits of the commit (more where 12 are
+  // ambiguous), after "TAG-N-g" when a tag is reachable, and "-dirty" if the tree had changes;
+  // "unknown" when the source is not a git checkout (or git is missing), as README.md says.
+  const std::regex from_git(R"(millsim 0\.1\.0 \((.+-g)?([0-9a-f]{12,})(-dirty)?\)\n)");
   const std::regex outside_git(R"(millsim 0\.1\.0 \(unknown\)\n)");
   const fs::path source(MILLSIM_SOURCE_DIR);
   // The test asks git the same question version.cmake asks: is there a checkout it can read?
@@ -132,11 +132,11 @@ TEST_F(Cli, VersionPrintsTheVersionAndTheSourceRevision) {
   if (checkout) {
     ASSERT_TRUE(std::regex_match(o.out, match, from_git)) << o.out;
     // And the digits name a commit of this checkout, not any 12 hex digits.
-    EXPECT_EQ(std::system(("git -C " + quoted(source.string()) + " cat-file -e " + match[1].str() +
+    EXPECT_EQ(std::system(("git -C " + quoted(source.string()) + " cat-file -e " + match[2].str() +
                            "^{commit} 2>/dev/null")
                               .c_str()),
               0)
-        << match[1] << " is not a commit of " << source;
+        << match[2] << " is not a commit of " << source;
   } else {
     EXPECT_TRUE(std::regex_match(o.out, outside_git) || std::regex_match(o.out, from_git)) << o.out;
   }
@@ -648,6 +648,33 @@ TEST_F(Cli, OutOverridesTheOutputDirectoryOfTheConfigAndOfSetAsAPlainPath) {
 /// validate replaces.
 std::string validation_case(std::string_view reference) {
   return std::string(base_config) + "\n[reference]\n" + std::string(reference);
+}
+
+TEST_F(Cli, ValidateRefusesWhatWouldTakeTheNameOfItsTableBeforeAnyCaseRuns) {
+  fs::create_directories(work_ / "cases");
+  std::ofstream(work_ / "cases" / "a.toml")
+      << validation_case("case = \"a\"\nmeasured_power_kw = 0.6\n");
+  // A directory where the table goes: refused, not found once every case has run.
+  fs::create_directories(work_ / "runs" / "validation.csv" / "kept");
+  const Outcome in_the_way = millsim(std::string("validate cases -o runs ") + tiny_run);
+  EXPECT_EQ(in_the_way.status, 2) << in_the_way.err;
+  EXPECT_NE(in_the_way.err.find("command line (--out runs): \"runs/validation.csv\" is a "
+                                "directory, where validate writes its table; allowed:"),
+            std::string::npos)
+      << in_the_way.err;
+  EXPECT_EQ(in_the_way.err.find("running"), std::string::npos) << in_the_way.err;
+  EXPECT_FALSE(fs::exists(work_ / "runs" / "a"));
+  EXPECT_TRUE(fs::exists(work_ / "runs" / "validation.csv" / "kept"));
+  fs::remove_all(work_ / "runs");
+  // A case whose results would go to OUT/validation.csv/.
+  fs::copy_file(work_ / "cases" / "a.toml", work_ / "cases" / "validation.csv.toml");
+  const Outcome named = millsim(std::string("validate cases -o runs ") + tiny_run);
+  EXPECT_EQ(named.status, 2) << named.err;
+  EXPECT_NE(named.err.find("cases/validation.csv.toml: a case named validation.csv would write "
+                           "its results where validate writes its table"),
+            std::string::npos)
+      << named.err;
+  EXPECT_FALSE(fs::exists(work_ / "runs"));
 }
 
 TEST_F(Cli, ValidateReadsEveryCaseBeforeRunningAnyAndShowsAMissingPaperFigureAsNa) {

@@ -3,6 +3,7 @@
 // they were added, as without renumbering.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <stdlib.h>
 
 #include <algorithm>
 #include <cmath>
@@ -41,6 +42,15 @@ std::size_t renumbered(const World<2>& world) {
     moved += world.particle_id(i) != i ? 1 : 0;
   }
   return moved;
+}
+
+/// A directory of its own under the system's temporary directory (test programs may run at
+/// the same time).
+std::filesystem::path fresh_directory() {
+  std::string pattern =
+      (std::filesystem::temp_directory_path() / "millsim-particle-order-XXXXXX").string();
+  EXPECT_NE(mkdtemp(pattern.data()), nullptr);
+  return pattern;
 }
 
 /// The lines of a text file.
@@ -110,9 +120,7 @@ TEST(ParticleOrder, RenumberedParticlesKeepTheirIdsContactsAndPhysics) {
 TEST(ParticleOrder, SnapshotListsParticlesById) {
   const World<2> world = falling_charge(1, 1000);
   ASSERT_GT(renumbered(world), 0u);
-  const auto directory = std::filesystem::temp_directory_path() / "millsim-particle-order";
-  std::filesystem::remove_all(directory);
-  std::filesystem::create_directories(directory);
+  const std::filesystem::path directory = fresh_directory();
   {
     SnapshotWriter snapshots(directory);
     snapshots.write(world);
@@ -167,8 +175,7 @@ trajectory_interval = 0.005
   world.step();
   EXPECT_EQ(renumbered(world), static_cast<std::size_t>(count)) << "reversed by the cell order";
 
-  const auto directory = std::filesystem::temp_directory_path() / "millsim-scene-order";
-  std::filesystem::create_directories(directory);
+  const std::filesystem::path directory = fresh_directory();
   run_scene(plan, directory);
   const std::vector<std::string> final_rows = lines_of(directory / "final.csv");
   ASSERT_EQ(final_rows.size(), static_cast<std::size_t>(count + 1));

@@ -4,9 +4,11 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
@@ -284,14 +286,16 @@ void SnapshotWriter::write(const World<D>& world) {
   if (index_ == nullptr) {
     index_ = std::fopen(index_path.c_str(), "wb");
     if (index_ == nullptr) {
-      throw std::runtime_error(fmt::format("{}: cannot write", index_path.string()));
+      throw std::runtime_error(
+          fmt::format("{}: cannot write: {}", index_path.string(), std::strerror(errno)));
     }
     std::fputs("snapshot,file,time_s,shell_angle_rad\n", index_);
   }
   fmt::print(index_, "{},{},{},{}\n", count_, name, world.time(),
              world.walls().mill ? world.walls().mill->angle : 0.0);
   if (std::fflush(index_) != 0 || std::ferror(index_) != 0) {
-    throw std::runtime_error(fmt::format("{}: write failed", index_path.string()));
+    throw std::runtime_error(
+        fmt::format("{}: write failed: {}", index_path.string(), std::strerror(errno)));
   }
   ++count_;
 }

@@ -3,8 +3,10 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <iterator>
 #include <stdexcept>
 #include <string_view>
@@ -311,11 +313,15 @@ PvdCollection::~PvdCollection() {
 
 void PvdCollection::add(double time, const std::vector<std::string>& files) {
   const auto failed = [&] {
-    return std::runtime_error(fmt::format("{}: write failed", path_.string()));
+    return std::runtime_error(
+        fmt::format("{}: write failed: {}", path_.string(), std::strerror(errno)));
   };
   if (file_ == nullptr) {
     file_ = std::fopen(path_.c_str(), "wb");
-    if (file_ == nullptr) throw std::runtime_error(fmt::format("{}: cannot write", path_.string()));
+    if (file_ == nullptr) {
+      throw std::runtime_error(
+          fmt::format("{}: cannot write: {}", path_.string(), std::strerror(errno)));
+    }
     std::fwrite(collection_head.data(), 1, collection_head.size(), file_);
     entries_end_ = static_cast<long>(collection_head.size());
   }

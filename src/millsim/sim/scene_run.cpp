@@ -50,13 +50,13 @@ template <int D>
 void write_row(std::FILE* file, double time, std::size_t id, const Vec<D>& x, const Vec<D>& v,
                const Spin<D>& w) {
   fmt::memory_buffer row;
-  fmt::format_to(std::back_inserter(row), "{:.17g},{}", time, id);
-  for (int k = 0; k < D; ++k) fmt::format_to(std::back_inserter(row), ",{:.17g}", x[k]);
-  for (int k = 0; k < D; ++k) fmt::format_to(std::back_inserter(row), ",{:.17g}", v[k]);
+  fmt::format_to(std::back_inserter(row), "{},{}", time, id);
+  for (int k = 0; k < D; ++k) fmt::format_to(std::back_inserter(row), ",{}", x[k]);
+  for (int k = 0; k < D; ++k) fmt::format_to(std::back_inserter(row), ",{}", v[k]);
   if constexpr (D == 2) {
-    fmt::format_to(std::back_inserter(row), ",{:.17g}\n", w);
+    fmt::format_to(std::back_inserter(row), ",{}\n", w);
   } else {
-    fmt::format_to(std::back_inserter(row), ",{:.17g},{:.17g},{:.17g}\n", w[0], w[1], w[2]);
+    fmt::format_to(std::back_inserter(row), ",{},{},{}\n", w[0], w[1], w[2]);
   }
   std::fwrite(row.data(), 1, row.size(), file);
 }
