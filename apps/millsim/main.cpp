@@ -287,6 +287,15 @@ int info_command(const JobOptions& options) {
       "{:.3g} steps\n",
       plan.total_time, c.settle_time, c.revolutions,
       c.revolutions == 1 ? "revolution" : "revolutions", plan.spin_up_time, steps);
+  if (plan.snapshot_count > 0.0) {
+    fmt::print("snapshots             every {} s: {:.0f} ({}), up to about {}\n",
+               c.snapshot_interval, plan.snapshot_count,
+               c.snapshot_csv && c.snapshot_vtk ? "CSV and VTK" : (c.snapshot_vtk ? "VTK" : "CSV"),
+               plan.snapshot_bytes >= 1e9 ? fmt::format("{:.3g} GB", plan.snapshot_bytes / 1e9)
+                                          : fmt::format("{:.3g} MB", plan.snapshot_bytes / 1e6));
+  } else {
+    fmt::print("snapshots             none (output.snapshot_interval = 0)\n");
+  }
   const millsim::EmpiricalPower empirical = millsim::empirical_power(plan);
   fmt::print("empirical power       {}, Hogg-Fuerstenau {:.4g} kW, Morrell net {:.4g} kW\n",
              millsim::bond_power_text(empirical.bond), empirical.hogg_fuerstenau.power_kw,

@@ -199,6 +199,27 @@ TEST(Mill, SnapshotVelocitiesAreAtTheTimeOfThePositions) {
   std::filesystem::remove_all(directory);
 }
 
+TEST(Mill, ARunWritesThePlannedSnapshotsInLessThanThePlannedBytes) {
+  const MillPlan plan = plan_mill(parse_mill_config(
+      builtin_example_toml, "lab-mill-2d.toml",
+      {"simulation.revolutions=1", "simulation.measure_revolutions=1", "simulation.settle_time=0.1",
+       "output.snapshot_interval=0.03", "output.snapshot_format=both"}));
+  std::string pattern =
+      (std::filesystem::temp_directory_path() / "millsim-snapshot-count-XXXXXX").string();
+  ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+  const std::filesystem::path directory = pattern;
+  (void)run_mill(plan, build_mill_world<2>(plan), directory);
+  const auto index = csv_numbers(directory / "index.csv");
+  EXPECT_EQ(static_cast<double>(index.size()), plan.snapshot_count);
+  double bytes = 0.0;
+  for (const auto& entry : std::filesystem::directory_iterator(directory)) {
+    if (entry.path().filename() != "index.csv") bytes += static_cast<double>(entry.file_size());
+  }
+  EXPECT_LT(bytes, plan.snapshot_bytes);
+  EXPECT_GT(bytes, 0.5 * plan.snapshot_bytes) << "the bound should not be far above";
+  std::filesystem::remove_all(directory);
+}
+
 TEST(Mill, TheSummaryTorqueIsTheMeanTorqueOfTheMeasuredWindow) {
   // One revolution, measured: the window takes in the spin-up, during which ω is below its set
   // value, so the mean torque is more than power / ω. The summary's torque is the mean torque,

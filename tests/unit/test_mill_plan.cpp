@@ -3,6 +3,7 @@
 // comment above its check. The mill is the built-in example: D = 0.9 m, L = 0.15 m, J = 0.30,
 // 5.08 cm steel balls (ρ = 7800 kg/m³, porosity 0.4), half critical speed, eight 4 × 4 cm lifters,
 // k_n = 4e5 N/m, k_s = 3e5 N/m, e = 0.6 for ball–ball and ball–wall.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -207,6 +208,35 @@ TEST(MillPlan, AGivenTimeStepOfFewerThanTenStepsPerContactIsRunWithAWarning) {
         "\"auto\" takes 0.00013 s, 1/20 of it"}) {
     EXPECT_NE(warning.find(part), std::string::npos) << warning;
   }
+}
+
+TEST(MillPlan, SnapshotsAreCountedAndTheirSizeBoundedWithAWarningWhenLarge) {
+  // The built-in example: 17.012954 s at Δt = 1.3019180e-4 s (above), a snapshot every
+  // 0.05 s: floor((17.012954 − Δt/2) / 0.05) + 1 = floor(340.258) + 1 = 341, of 75 discs.
+  const MillPlan csv = plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml"));
+  EXPECT_EQ(csv.snapshot_count, 341.0);
+  EXPECT_EQ(csv.snapshot_bytes, 341.0 * 75.0 * snapshot_bytes_per_particle(2, false));
+  const MillPlan both = plan_mill(
+      parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", {"output.snapshot_format=both"}));
+  EXPECT_EQ(both.snapshot_bytes, 341.0 * (75.0 * (snapshot_bytes_per_particle(2, false) +
+                                                  snapshot_bytes_per_particle(2, true)) +
+                                          snapshot_mill_bytes(2)));
+  EXPECT_TRUE(both.warnings.empty());
+  const MillPlan none = plan_mill(lab_mill());
+  EXPECT_EQ(none.snapshot_count, 0.0);
+  EXPECT_EQ(none.snapshot_bytes, 0.0);
+  // Small balls and a snapshot every 2 ms: beyond snapshot_bytes_warned, said with the key.
+  const MillPlan large =
+      plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml",
+                                  {"charge.ball_diameter=0.005", "output.snapshot_interval=0.0002",
+                                   "output.snapshot_format=both"}));
+  ASSERT_GT(large.snapshot_bytes, snapshot_bytes_warned);
+  ASSERT_EQ(large.warnings.size(), 1U);
+  EXPECT_EQ(large.warnings[0],
+            fmt::format("command line (--set output.snapshot_interval=0.0002): "
+                        "output.snapshot_interval: {:.0f} snapshots of {} particles take up to "
+                        "about {:.0f} GB of disk; a longer interval takes less, 0 none",
+                        large.snapshot_count, large.particle_count, large.snapshot_bytes / 1e9));
 }
 
 TEST(MillPlan, AutoTimeStepStaysAtAQuarterOfTheStabilityLimitWhenTheTangentialSpringIsStiff) {

@@ -254,6 +254,29 @@ MillPlan plan_mill(const MillConfig& config) {
         "(no snapshots) or at least the time step",
         config.location_of("output.snapshot_interval"), config.snapshot_interval, plan.time_step));
   }
+  if (config.snapshot_interval > 0.0) {
+    // The run writes a snapshot before the first step whose start is within half a step of
+    // the next multiple of the interval, and its last step starts one step before the end.
+    plan.snapshot_count =
+        std::floor((plan.total_time - 0.5 * plan.time_step) / config.snapshot_interval) + 1.0;
+    const double particles = static_cast<double>(plan.particle_count);
+    double per_snapshot = 0.0;
+    if (config.snapshot_csv) {
+      per_snapshot += particles * snapshot_bytes_per_particle(config.dimension, false);
+    }
+    if (config.snapshot_vtk) {
+      per_snapshot += particles * snapshot_bytes_per_particle(config.dimension, true) +
+                      snapshot_mill_bytes(config.dimension);
+    }
+    plan.snapshot_bytes = plan.snapshot_count * per_snapshot;
+    if (plan.snapshot_bytes > snapshot_bytes_warned) {
+      plan.warnings.push_back(fmt::format(
+          "{}: output.snapshot_interval: {:.0f} snapshots of {} particles take up to about {:.0f} "
+          "GB of disk; a longer interval takes less, 0 none",
+          config.location_of("output.snapshot_interval"), plan.snapshot_count, plan.particle_count,
+          plan.snapshot_bytes / 1e9));
+    }
+  }
   return plan;
 }
 

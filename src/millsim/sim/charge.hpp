@@ -68,10 +68,31 @@ struct MillPlan {
   /// s, settling + rotation: settle_time + spin_up_time / 2 + revolutions × revolution_period
   /// (the ramp turns the shell as half its time at full speed would)
   double total_time = 0.0;
+  /// Snapshots the run writes: one at each multiple of output.snapshot_interval before the
+  /// last step (the last may fall either side of the end by a step); 0 without snapshots.
+  double snapshot_count = 0.0;
+  /// Bytes those snapshots take on disk, at most about: snapshot_count times the particles'
+  /// rows (snapshot_bytes_per_particle) and, as VTK, the mill's walls (snapshot_mill_bytes).
+  double snapshot_bytes = 0.0;
   /// What in the config makes the results doubtful without making the run impossible (a
-  /// coarse time step), one sentence each, naming the file, line and key.
+  /// coarse time step), or the run's output larger than a disk is likely to hold (snapshots
+  /// above snapshot_bytes_warned), one sentence each, naming the file, line and key.
   std::vector<std::string> warnings;
 };
+
+/// Bytes a particle's row takes in a snapshot, at most about, by dimension and format: the
+/// numbers of a turning mill's rows, 17 significant digits each at most (2D CSV 136 and VTK
+/// 168, 3D 232 and 244 bytes a particle in the built-in example's mill), with room to spare.
+inline constexpr double snapshot_bytes_per_particle(int dimension, bool vtk) {
+  return dimension == 2 ? (vtk ? 200.0 : 170.0) : (vtk ? 300.0 : 280.0);
+}
+/// Bytes of a snapshot's mill_NNNNNN.vtp, at most about (2D 11 kB; 3D 26 kB with flat ends,
+/// 50 kB with cones).
+inline constexpr double snapshot_mill_bytes(int dimension) {
+  return dimension == 2 ? 12e3 : 60e3;
+}
+/// Snapshots above this many bytes in all are warned of (MillPlan::warnings).
+inline constexpr double snapshot_bytes_warned = 20e9;
 
 /// Area of the part of a circle of `radius` below the horizontal line at `level` from its
 /// centre (negative: below the centre), m².
