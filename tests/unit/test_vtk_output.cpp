@@ -207,9 +207,10 @@ TEST(VtkOutput, ThreeDimensionalMillsHaveTheirEndsOrNone) {
   const std::string cone_file = mill_vtp(cones);
   const std::vector<double> cone_points = array_of(cone_file, "NumberOfComponents=\"3\" format");
   const double trunnion = 0.45 - 0.05 / std::tan(20.0 * pi / 180.0);
-  const std::size_t first_trunnion = 2 * shell_segments + 8 * 8;
-  ASSERT_EQ(cone_points.size(), 3 * (first_trunnion + 2 * shell_segments));
-  for (std::size_t k = first_trunnion; k < first_trunnion + 2 * shell_segments; ++k) {
+  const auto segments = static_cast<std::size_t>(shell_segments);
+  const std::size_t first_trunnion = 2 * segments + std::size_t{8} * 8;  // 8 lifters, 8 corners
+  ASSERT_EQ(cone_points.size(), 3 * (first_trunnion + 2 * segments));
+  for (std::size_t k = first_trunnion; k < first_trunnion + 2 * segments; ++k) {
     const double* p = &cone_points[3 * k];
     EXPECT_NEAR(std::hypot(p[0], p[1]), trunnion, 1e-14);
     EXPECT_EQ(p[2],
