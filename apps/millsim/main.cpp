@@ -351,12 +351,15 @@ int validate_command(const std::string& directory, const JobOptions& options) {
   // The table's name, OUT/validation.csv, is checked before any case is read: a directory
   // there would fail the validation only once every case had run.
   const std::filesystem::path table_path = root / "validation.csv";
-  std::error_code unknown;
-  if (std::filesystem::is_directory(table_path, unknown)) {
-    throw millsim::InputError(fmt::format(
-        "{}: \"{}\" is a directory, where validate writes its table; allowed: an output "
-        "directory without a directory of that name (remove or rename it)",
-        root_location, table_path.string()));
+  for (const std::filesystem::path& name :
+       {table_path, std::filesystem::path(table_path.string() + ".partial")}) {
+    std::error_code unknown;
+    if (std::filesystem::is_directory(name, unknown)) {
+      throw millsim::InputError(fmt::format(
+          "{}: \"{}\" is a directory, where validate writes its table; allowed: an output "
+          "directory without a directory of that name (remove or rename it)",
+          root_location, name.string()));
+    }
   }
   std::vector<MillPlan> plans;
   for (const auto& path : cases) {

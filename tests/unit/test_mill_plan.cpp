@@ -220,11 +220,19 @@ TEST(MillPlan, SnapshotsAreCountedAndTheirSizeBoundedWithAWarningWhenLarge) {
       parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", {"output.snapshot_format=both"}));
   EXPECT_EQ(both.snapshot_bytes, 341.0 * (75.0 * (snapshot_bytes_per_particle(2, false) +
                                                   snapshot_bytes_per_particle(2, true)) +
-                                          snapshot_mill_bytes(2)));
+                                          snapshot_mill_bytes(2, 8, false)));
   EXPECT_TRUE(both.warnings.empty());
   const MillPlan none = plan_mill(lab_mill());
   EXPECT_EQ(none.snapshot_count, 0.0);
   EXPECT_EQ(none.snapshot_bytes, 0.0);
+  EXPECT_TRUE(none.warnings.empty());
+  // A format asked for with no snapshots to write is said to be without effect.
+  const MillPlan unused = plan_mill(lab_mill({"output.snapshot_format=vtk"}));
+  ASSERT_EQ(unused.warnings.size(), 1U);
+  EXPECT_EQ(unused.warnings[0],
+            "command line (--set output.snapshot_format=vtk): output.snapshot_format: \"vtk\" is "
+            "set, but output.snapshot_interval is 0 (command line (--set "
+            "output.snapshot_interval=0)): no snapshots are written");
   // Small balls and a snapshot every 2 ms: beyond snapshot_bytes_warned, said with the key.
   const MillPlan large =
       plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml",

@@ -79,7 +79,9 @@ TEST_F(PartialFileTest, FailsInADirectoryItCannotWriteNamingThePath) {
     millsim::PartialFile file(path);
     FAIL() << "opened " << path;
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(std::string(e.what()), path.string() + ".partial: cannot write");
+    EXPECT_EQ(std::string(e.what()),
+              path.string() + ".partial: cannot write: " +
+                  std::make_error_code(std::errc::no_such_file_or_directory).message());
   }
 }
 

@@ -3,20 +3,25 @@
 // whole file after every snapshot.
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <sys/resource.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <csignal>
 #include <cstddef>
 #include <filesystem>
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <system_error>
 #include <vector>
 
 #include "millsim/builtin_example.hpp"
 #include "millsim/core/constants.hpp"
 #include "millsim/io/config.hpp"
 #include "millsim/io/output.hpp"
+#include "millsim/io/partial_file.hpp"
 #include "millsim/io/vtk_output.hpp"
 #include "millsim/sim/charge.hpp"
 #include "support/program_test.hpp"
@@ -218,6 +223,121 @@ TEST(VtkOutput, ThreeDimensionalMillsHaveTheirEndsOrNone) {
   }
 }
 
+/// The polygons of a mill file: each one's corners, and its wall (0 shell, 1 lifter, 2 end).
+struct Polygons {
+  std::vector<std::vector<std::array<double, 3>>> corners;
+  std::vector<int> wall;
+};
+
+Polygons polygons_of(std::string_view file) {
+  const std::vector<double> points = array_of(file, "NumberOfComponents=\"3\" format");
+  const std::string_view polys = file.substr(file.find("<Polys>"));
+  const std::vector<double> connectivity = array_of(polys, "Name=\"connectivity\"");
+  const std::vector<double> offsets = array_of(polys, "Name=\"offsets\"");
+  const std::vector<double> wall = array_of(file, "Name=\"wall\"");
+  Polygons out;
+  std::size_t start = 0;
+  for (const double end : offsets) {
+    std::vector<std::array<double, 3>> corners;
+    for (auto k = start; k < static_cast<std::size_t>(end); ++k) {
+      const auto p = 3 * static_cast<std::size_t>(connectivity[k]);
+      corners.push_back({points[p], points[p + 1], points[p + 2]});
+    }
+    out.corners.push_back(corners);
+    start = static_cast<std::size_t>(end);
+  }
+  // The wall array holds the lines' values first (none in 3D), then the polygons'.
+  const std::size_t lines = wall.size() - offsets.size();
+  for (std::size_t k = lines; k < wall.size(); ++k) out.wall.push_back(static_cast<int>(wall[k]));
+  return out;
+}
+
+std::array<double, 3> centroid(const std::vector<std::array<double, 3>>& corners) {
+  std::array<double, 3> c{};
+  for (const auto& p : corners) {
+    for (std::size_t k = 0; k < 3; ++k) c[k] += p[k] / static_cast<double>(corners.size());
+  }
+  return c;
+}
+
+/// Newell's normal of a polygon: by the right-hand rule over its corners' order.
+std::array<double, 3> normal_of(const std::vector<std::array<double, 3>>& corners) {
+  std::array<double, 3> n{};
+  for (std::size_t k = 0; k < corners.size(); ++k) {
+    const auto& a = corners[k];
+    const auto& b = corners[(k + 1) % corners.size()];
+    n[0] += (a[1] - b[1]) * (a[2] + b[2]);
+    n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+    n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+  }
+  return n;
+}
+
+double dot3(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+std::array<double, 3> minus3(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+
+TEST(VtkOutput, ThreeDimensionalLiftersAreTheContactGeometrysBoxes) {
+  // Lifter j's box: radial a ∈ {R − h, R}, tangential b = ±w/2 about the direction
+  // 0.3 + 2πj/8, z ∈ {0, L} (mill_geometry.cpp's frame), for the mill turned to 0.3 rad.
+  World<3> world = example_world<3>({"simulation.dimension=3"}, 0);
+  world.walls().mill->turn_to(0.3);
+  const Polygons mesh = polygons_of(mill_vtp(world));
+  const double length = world.walls().mill->length;
+  int lifter_faces = 0;
+  for (std::size_t k = 0; k < mesh.corners.size(); ++k) {
+    if (mesh.wall[k] != 1) continue;
+    const int j = lifter_faces++ / 6;
+    const double angle = 0.3 + 2.0 * pi * j / 8.0;
+    for (const auto& p : mesh.corners[k]) {
+      const double a = p[0] * std::cos(angle) + p[1] * std::sin(angle);
+      const double b = -p[0] * std::sin(angle) + p[1] * std::cos(angle);
+      EXPECT_TRUE(std::abs(a - 0.41) < 1e-15 || std::abs(a - 0.45) < 1e-15) << a;
+      EXPECT_NEAR(std::abs(b), 0.02, 1e-15);
+      EXPECT_TRUE(p[2] == 0.0 || p[2] == length) << p[2];
+    }
+  }
+  EXPECT_EQ(lifter_faces, 6 * 8);
+}
+
+TEST(VtkOutput, PolygonsFaceOutOfTheMillAndOutOfEachLiftersBox) {
+  for (const auto& overrides : std::vector<std::vector<std::string>>{
+           {"simulation.dimension=3"},
+           {"simulation.dimension=3", "mill.cone_angle=20", "mill.cone_length=0.05"}}) {
+    const World<3> world = example_world<3>(overrides, 0);
+    const Polygons mesh = polygons_of(mill_vtp(world));
+    // The mill's inside is convex: out of it is away from its centre on the axis.
+    const std::array<double, 3> middle{0.0, 0.0, 0.5 * world.walls().mill->length};
+    std::vector<std::size_t> box;
+    for (std::size_t k = 0; k < mesh.corners.size(); ++k) {
+      const auto n = normal_of(mesh.corners[k]);
+      if (mesh.wall[k] != 1) {
+        EXPECT_GT(dot3(n, minus3(centroid(mesh.corners[k]), middle)), 0.0)
+            << "wall " << mesh.wall[k] << " polygon " << k << " faces into the mill";
+        continue;
+      }
+      box.push_back(k);
+      if (box.size() < 6) continue;
+      // A lifter's six faces: each away from the box's centre.
+      std::array<double, 3> box_centre{};
+      for (const std::size_t f : box) {
+        const auto c = centroid(mesh.corners[f]);
+        for (std::size_t d = 0; d < 3; ++d) box_centre[d] += c[d] / 6.0;
+      }
+      for (const std::size_t f : box) {
+        EXPECT_GT(dot3(normal_of(mesh.corners[f]), minus3(centroid(mesh.corners[f]), box_centre)),
+                  0.0)
+            << "lifter face " << f << " faces into its box";
+      }
+      box.clear();
+    }
+  }
+}
+
 /// A directory of its own under the system's temporary directory.
 std::filesystem::path fresh_directory() {
   std::string pattern = (std::filesystem::temp_directory_path() / "millsim-vtk-XXXXXX").string();
@@ -247,6 +367,61 @@ TEST(VtkOutput, TheCollectionIsWholeAfterEverySnapshot) {
                                   "file=\"mill_000001.vtp\"/>\n" +
                                   tail);
   }
+  std::filesystem::remove_all(directory);
+}
+
+TEST(VtkOutput, ACollectionWhoseWriteFailsIsLeftWholeWithWhatItListed) {
+  // A file-size limit the collection's third entry passes (SIGXFSZ ignored, so that the write
+  // fails with EFBIG instead of ending the process).
+  const std::filesystem::path directory = fresh_directory();
+  const std::filesystem::path path = directory / "particles.pvd";
+  const std::string entry = "snapshot_000000.vtp";
+  rlimit saved{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  std::string whole_after_two;
+  std::string message;
+  {
+    PvdCollection collection(path);
+    collection.add(0.0, {entry});
+    collection.add(0.05, {entry});
+    whole_after_two = read_all(path);
+    rlimit small = saved;
+    small.rlim_cur = whole_after_two.size() + 10;
+    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+    try {
+      collection.add(0.1, {entry});
+    } catch (const std::runtime_error& e) {
+      message = e.what();
+    }
+    setrlimit(RLIMIT_FSIZE, &saved);
+  }
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_EQ(message, path.string() + ": write failed: " +
+                         std::make_error_code(std::errc::file_too_large).message());
+  EXPECT_EQ(read_all(path), whole_after_two);
+  std::filesystem::remove_all(directory);
+}
+
+TEST(VtkOutput, AFileWhoseWriteFailsSaysWhy) {
+  const std::filesystem::path directory = fresh_directory();
+  rlimit saved{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit small = saved;
+  small.rlim_cur = 1000;
+  std::string message;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  try {
+    write_whole_file(directory / "snapshot_000000.vtp", std::string(5000, 'x'));
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  setrlimit(RLIMIT_FSIZE, &saved);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_EQ(message, (directory / "snapshot_000000.vtp").string() + ": write failed: " +
+                         std::make_error_code(std::errc::file_too_large).message());
+  EXPECT_FALSE(std::filesystem::exists(directory / "snapshot_000000.vtp.partial"));
   std::filesystem::remove_all(directory);
 }
 

@@ -291,11 +291,13 @@ void SnapshotWriter::write(const World<D>& world) {
     }
     std::fputs("snapshot,file,time_s,shell_angle_rad\n", index_);
   }
-  fmt::print(index_, "{},{},{},{}\n", count_, name, world.time(),
-             world.walls().mill ? world.walls().mill->angle : 0.0);
-  if (std::fflush(index_) != 0 || std::ferror(index_) != 0) {
-    throw std::runtime_error(
-        fmt::format("{}: write failed: {}", index_path.string(), std::strerror(errno)));
+  const std::string row = fmt::format("{},{},{},{}\n", count_, name, world.time(),
+                                      world.walls().mill ? world.walls().mill->angle : 0.0);
+  errno = 0;
+  if (std::fwrite(row.data(), 1, row.size(), index_) != row.size() || std::fflush(index_) != 0) {
+    const int error = errno;
+    throw std::runtime_error(fmt::format("{}: write failed: {}", index_path.string(),
+                                         error != 0 ? std::strerror(error) : "unknown error"));
   }
   ++count_;
 }

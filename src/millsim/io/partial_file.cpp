@@ -1,5 +1,7 @@
 #include "millsim/io/partial_file.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -13,7 +15,15 @@ PartialFile::PartialFile(std::filesystem::path path)
   if (file_ == nullptr) {
     // A run failure (exit status 1), not refused input: the output directory was made and
     // checked before the run began.
-    throw std::runtime_error(fmt::format("{}: cannot write", partial_.string()));
+    throw std::runtime_error(
+        fmt::format("{}: cannot write: {}", partial_.string(), std::strerror(errno)));
+  }
+}
+
+void PartialFile::write(std::string_view text) {
+  errno = 0;
+  if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() && error_ == 0) {
+    error_ = errno != 0 ? errno : EIO;
   }
 }
 
@@ -26,16 +36,20 @@ PartialFile::~PartialFile() {
 
 void PartialFile::commit() {
   if (file_ == nullptr) throw std::logic_error(fmt::format("{}: committed twice", path_.string()));
-  const bool write_failed = std::ferror(file_) != 0;
-  const bool close_failed = std::fclose(file_) != 0;
+  // The reason of the first failure: a write, the close (which writes what is buffered), or
+  // the rename.
+  int error = error_ != 0 ? error_ : (std::ferror(file_) != 0 ? EIO : 0);
+  errno = 0;
+  if (std::fclose(file_) != 0 && error == 0) error = errno != 0 ? errno : EIO;
   file_ = nullptr;
-  std::error_code error;
-  if (!write_failed && !close_failed) std::filesystem::rename(partial_, path_, error);
-  if (write_failed || close_failed || error) {
+  std::error_code rename_error;
+  if (error == 0) std::filesystem::rename(partial_, path_, rename_error);
+  if (error != 0 || rename_error) {
     std::error_code ignored;
     std::filesystem::remove(partial_, ignored);
-    throw std::runtime_error(fmt::format("{}: write failed{}", path_.string(),
-                                         error ? ": " + error.message() : std::string()));
+    throw std::runtime_error(
+        fmt::format("{}: write failed: {}", path_.string(),
+                    error != 0 ? std::strerror(error) : rename_error.message()));
   }
 }
 

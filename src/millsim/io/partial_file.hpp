@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 #include <string>
 #include <string_view>
 
@@ -20,12 +21,13 @@ class PartialFile {
   PartialFile(const PartialFile&) = delete;
   PartialFile& operator=(const PartialFile&) = delete;
 
-  /// The open file, for writers that print into it themselves.
-  std::FILE* get() { return file_; }
-  void write(std::string_view text) { std::fwrite(text.data(), 1, text.size(), file_); }
+  /// Appends `text`; a failure (a full disk, say) is kept, with its reason, for commit().
+  void write(std::string_view text);
   template <typename... Args>
   void print(fmt::format_string<Args...> format, Args&&... args) {
-    fmt::print(file_, format, std::forward<Args>(args)...);
+    fmt::memory_buffer text;
+    fmt::format_to(std::back_inserter(text), format, std::forward<Args>(args)...);
+    write({text.data(), text.size()});
   }
   /// Closes the file and renames it to its final name; throws std::runtime_error (and removes
   /// the .partial) if any write, the close or the rename failed, a full disk among them. Once.
@@ -35,6 +37,7 @@ class PartialFile {
   std::filesystem::path path_;
   std::filesystem::path partial_;
   std::FILE* file_ = nullptr;
+  int error_ = 0;  // errno of the first write that failed
 };
 
 /// Writes `text` to `path` through a PartialFile.

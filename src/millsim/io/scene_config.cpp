@@ -26,8 +26,8 @@ namespace {
 
 std::string scene_hint(std::string_view key) {
   static constexpr std::string_view mill_only[] = {
-      "settle_time", "revolutions", "measure_revolutions", "seed",
-      "mill",        "charge",      "reference",           "snapshot_interval",
+      "settle_time", "revolutions",       "measure_revolutions", "seed", "mill", "charge",
+      "reference",   "snapshot_interval", "snapshot_format",
   };
   if (std::find(std::begin(mill_only), std::end(mill_only), key) != std::end(mill_only)) {
     return "a mill key; a scene (a config without [mill]) does not use it";

@@ -1,7 +1,9 @@
 #include "millsim/io/vtk_output.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cmath>
@@ -10,6 +12,7 @@
 #include <iterator>
 #include <stdexcept>
 #include <string_view>
+#include <system_error>
 #include <utility>
 
 #include "millsim/core/constants.hpp"
@@ -133,7 +136,12 @@ std::int64_t add_ring(Mesh& mesh, double radius, double z, double shell_angle) {
   return first;
 }
 
-/// Quadrilaterals joining two rings of add_ring.
+// Polygons are wound so that their normals (right-handed) point out of the closed surface
+// they belong to: out of the mill (the shell radially out, the near end towards −z, the far
+// end towards +z) and out of each lifter's box, into the mill.
+
+/// Quadrilaterals joining two rings of add_ring: facing radially out when `b` lies further
+/// along +z than `a`.
 void join_rings(Mesh& mesh, std::int64_t a, std::int64_t b, std::int64_t wall) {
   for (std::int64_t k = 0; k < shell_segments; ++k) {
     const std::int64_t next = (k + 1) % shell_segments;
@@ -141,10 +149,11 @@ void join_rings(Mesh& mesh, std::int64_t a, std::int64_t b, std::int64_t wall) {
   }
 }
 
-/// The disc closing a ring of add_ring.
-void close_ring(Mesh& mesh, std::int64_t ring) {
+/// The disc closing a ring of add_ring, facing +z (`towards_plus_z`) or −z.
+void close_ring(Mesh& mesh, std::int64_t ring, bool towards_plus_z) {
   std::vector<std::int64_t> corners;
   for (std::int64_t k = 0; k < shell_segments; ++k) corners.push_back(ring + k);
+  if (!towards_plus_z) std::reverse(corners.begin(), corners.end());
   mesh.add_poly(std::move(corners), end_wall);
 }
 
@@ -200,7 +209,7 @@ Mesh mill_mesh(const Mill3D& mill) {
                      c[static_cast<std::size_t>(r)], c[static_cast<std::size_t>(s)]},
                     lifter_wall);
     };
-    face(0, 1, 2, 3);  // the ends
+    face(3, 2, 1, 0);  // the ends: at z = 0 facing −z, at the far end +z
     face(4, 5, 6, 7);
     face(0, 1, 5, 4);  // the sides
     face(1, 2, 6, 5);
@@ -209,18 +218,18 @@ Mesh mill_mesh(const Mill3D& mill) {
   }
   if (mill.periodic) return mesh;
   if (!mill.has_cones()) {
-    close_ring(mesh, near);
-    close_ring(mesh, far);
+    close_ring(mesh, near, false);
+    close_ring(mesh, far, true);
     return mesh;
   }
   const double trunnion = mill.trunnion_radius();
   const double c = mill.cone_length;
   const std::int64_t near_trunnion = add_ring(mesh, trunnion, -c, mill.angle);
   const std::int64_t far_trunnion = add_ring(mesh, trunnion, length + c, mill.angle);
-  join_rings(mesh, near, near_trunnion, end_wall);
+  join_rings(mesh, near_trunnion, near, end_wall);  // from the trunnion towards +z: outward
   join_rings(mesh, far, far_trunnion, end_wall);
-  close_ring(mesh, near_trunnion);
-  close_ring(mesh, far_trunnion);
+  close_ring(mesh, near_trunnion, false);
+  close_ring(mesh, far_trunnion, true);
   return mesh;
 }
 
@@ -312,32 +321,49 @@ PvdCollection::~PvdCollection() {
 }
 
 void PvdCollection::add(double time, const std::vector<std::string>& files) {
-  const auto failed = [&] {
-    return std::runtime_error(
-        fmt::format("{}: write failed: {}", path_.string(), std::strerror(errno)));
-  };
-  if (file_ == nullptr) {
+  const bool first = file_ == nullptr;
+  if (first) {
     file_ = std::fopen(path_.c_str(), "wb");
     if (file_ == nullptr) {
       throw std::runtime_error(
           fmt::format("{}: cannot write: {}", path_.string(), std::strerror(errno)));
     }
-    std::fwrite(collection_head.data(), 1, collection_head.size(), file_);
-    entries_end_ = static_cast<long>(collection_head.size());
+    // Unbuffered: each add is one write, and nothing of a failed one stays pending.
+    std::setvbuf(file_, nullptr, _IONBF, 0);
   }
-  Buffer entries;
+  Buffer text;
+  if (first) text.append(collection_head);
   for (std::size_t part = 0; part < files.size(); ++part) {
-    fmt::format_to(std::back_inserter(entries),
+    fmt::format_to(std::back_inserter(text),
                    "    <DataSet timestep=\"{}\" group=\"\" part=\"{}\" file=\"{}\"/>\n", time,
                    part, files[part]);
   }
+  const auto entries_size = static_cast<long>(text.size());
+  text.append(collection_tail);
   // The new entries over the old closing tags, then the closing tags again: the file only
   // grows, and is whole again once this returns.
-  if (std::fseek(file_, entries_end_, SEEK_SET) != 0) throw failed();
-  std::fwrite(entries.data(), 1, entries.size(), file_);
-  entries_end_ += static_cast<long>(entries.size());
-  std::fwrite(collection_tail.data(), 1, collection_tail.size(), file_);
-  if (std::fflush(file_) != 0 || std::ferror(file_) != 0) throw failed();
+  errno = 0;
+  if (std::fseek(file_, entries_end_, SEEK_SET) == 0 &&
+      std::fwrite(text.data(), 1, text.size(), file_) == text.size() && std::fflush(file_) == 0) {
+    entries_end_ += entries_size;
+    return;
+  }
+  // Failed (a full disk, say): the collection as it was, whole, with what it listed (the
+  // first add's file removed: it listed nothing).
+  const int error = errno;
+  std::clearerr(file_);
+  if (first) {
+    std::fclose(file_);
+    file_ = nullptr;
+    std::error_code ignored;
+    std::filesystem::remove(path_, ignored);
+  } else if (::ftruncate(::fileno(file_), entries_end_) == 0 &&
+             std::fseek(file_, entries_end_, SEEK_SET) == 0) {
+    std::fwrite(collection_tail.data(), 1, collection_tail.size(), file_);
+    std::fflush(file_);
+  }
+  throw std::runtime_error(fmt::format("{}: write failed: {}", path_.string(),
+                                       error != 0 ? std::strerror(error) : "unknown error"));
 }
 
 }  // namespace millsim

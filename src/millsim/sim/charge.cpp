@@ -254,6 +254,14 @@ MillPlan plan_mill(const MillConfig& config) {
         "(no snapshots) or at least the time step",
         config.location_of("output.snapshot_interval"), config.snapshot_interval, plan.time_step));
   }
+  if (config.snapshot_interval == 0.0 && config.key_locations.contains("output.snapshot_format")) {
+    plan.warnings.push_back(fmt::format(
+        "{}: output.snapshot_format: \"{}\" is set, but output.snapshot_interval is 0 ({}): no "
+        "snapshots are written",
+        config.location_of("output.snapshot_format"),
+        config.snapshot_csv ? (config.snapshot_vtk ? "both" : "csv") : "vtk",
+        config.location_of("output.snapshot_interval")));
+  }
   if (config.snapshot_interval > 0.0) {
     // The run writes a snapshot before the first step whose start is within half a step of
     // the next multiple of the interval, and its last step starts one step before the end.
@@ -266,7 +274,9 @@ MillPlan plan_mill(const MillConfig& config) {
     }
     if (config.snapshot_vtk) {
       per_snapshot += particles * snapshot_bytes_per_particle(config.dimension, true) +
-                      snapshot_mill_bytes(config.dimension);
+                      snapshot_mill_bytes(
+                          config.dimension, config.lifter_count,
+                          config.dimension == 3 && !config.periodic && config.cone_length > 0.0);
     }
     plan.snapshot_bytes = plan.snapshot_count * per_snapshot;
     if (plan.snapshot_bytes > snapshot_bytes_warned) {

@@ -86,10 +86,11 @@ struct MillPlan {
 inline constexpr double snapshot_bytes_per_particle(int dimension, bool vtk) {
   return dimension == 2 ? (vtk ? 200.0 : 170.0) : (vtk ? 300.0 : 280.0);
 }
-/// Bytes of a snapshot's mill_NNNNNN.vtp, at most about (2D 11 kB; 3D 26 kB with flat ends,
-/// 50 kB with cones).
-inline constexpr double snapshot_mill_bytes(int dimension) {
-  return dimension == 2 ? 12e3 : 60e3;
+/// Bytes of a snapshot's mill_NNNNNN.vtp, at most about: the shell, and each lifter's corners
+/// and cells (measured: 2D 9.5 kB and 190 bytes a lifter; 3D 22 kB, 24 kB more with cones,
+/// and 500 bytes a lifter), with room to spare.
+inline constexpr double snapshot_mill_bytes(int dimension, int lifters, bool cones) {
+  return dimension == 2 ? 12e3 + 250.0 * lifters : 30e3 + (cones ? 30e3 : 0.0) + 650.0 * lifters;
 }
 /// Snapshots above this many bytes in all are warned of (MillPlan::warnings).
 inline constexpr double snapshot_bytes_warned = 20e9;

@@ -47,7 +47,7 @@ Spin<D> to_spin(const std::array<double, 3>& a) {
 
 /// One row of trajectory.csv or final.csv.
 template <int D>
-void write_row(std::FILE* file, double time, std::size_t id, const Vec<D>& x, const Vec<D>& v,
+void write_row(PartialFile& file, double time, std::size_t id, const Vec<D>& x, const Vec<D>& v,
                const Spin<D>& w) {
   fmt::memory_buffer row;
   fmt::format_to(std::back_inserter(row), "{},{}", time, id);
@@ -58,12 +58,12 @@ void write_row(std::FILE* file, double time, std::size_t id, const Vec<D>& x, co
   } else {
     fmt::format_to(std::back_inserter(row), ",{},{},{}\n", w[0], w[1], w[2]);
   }
-  std::fwrite(row.data(), 1, row.size(), file);
+  file.write({row.data(), row.size()});
 }
 
 /// Every particle's row, in the order of their ids (the order of the config).
 template <int D>
-void write_state(std::FILE* file, const World<D>& world) {
+void write_state(PartialFile& file, const World<D>& world) {
   for (std::size_t id = 0; id < world.particles().size(); ++id) {
     const std::size_t i = world.particle_index(id);
     const auto [v, w] = motion_at_positions(world, i);
@@ -245,7 +245,7 @@ SceneResult run_scene_in(const ScenePlan& plan, const std::filesystem::path& dir
     const SceneParticle& sp = plan.config.particles[i];
     const Vec<D> v = to_vec<D>(sp.velocity);
     const Spin<D> w = to_spin<D>(sp.angular_velocity);
-    write_row<D>(trajectory.get(), 0.0, i, p.position[i], v, w);
+    write_row<D>(trajectory, 0.0, i, p.position[i], v, w);
     result.kinetic_start += kinetic_energy(p, i, v, w);
   }
   result.potential_start = world.potential_energy();
@@ -255,13 +255,13 @@ SceneResult run_scene_in(const ScenePlan& plan, const std::filesystem::path& dir
     world.step();
     const bool last = step == plan.steps;
     if (last || (plan.trajectory_every > 0 && step % plan.trajectory_every == 0)) {
-      write_state(trajectory.get(), world);
+      write_state(trajectory, world);
     }
     if (progress && step % report_every == 0) progress(world.time(), plan.config.duration);
   }
   PartialFile final_state(directory / "final.csv");
   final_state.write(header<D>());
-  write_state(final_state.get(), world);
+  write_state(final_state, world);
 
   result.steps = world.steps();
   result.simulated_seconds = world.time();
