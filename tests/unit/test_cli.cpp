@@ -666,6 +666,14 @@ TEST_F(Cli, ValidateRefusesWhatWouldTakeTheNameOfItsTableBeforeAnyCaseRuns) {
   EXPECT_FALSE(fs::exists(work_ / "runs" / "a"));
   EXPECT_TRUE(fs::exists(work_ / "runs" / "validation.csv" / "kept"));
   fs::remove_all(work_ / "runs");
+  // The same for the name the table is written under before it is renamed.
+  fs::create_directories(work_ / "runs" / "validation.csv.partial" / "kept");
+  const Outcome partial = millsim(std::string("validate cases -o runs ") + tiny_run);
+  EXPECT_EQ(partial.status, 2) << partial.err;
+  EXPECT_NE(partial.err.find("\"runs/validation.csv.partial\" is a directory"), std::string::npos)
+      << partial.err;
+  EXPECT_FALSE(fs::exists(work_ / "runs" / "a"));
+  fs::remove_all(work_ / "runs");
   // A case whose results would go to OUT/validation.csv/.
   fs::copy_file(work_ / "cases" / "a.toml", work_ / "cases" / "validation.csv.toml");
   const Outcome named = millsim(std::string("validate cases -o runs ") + tiny_run);

@@ -200,6 +200,10 @@ TEST(SceneConfig, RefusesAnUnstableTimeStepAndGivesTheLimit) {
 TEST(SceneConfig, RefusesAMillKeyInAScene) {
   expect_refused(std::string(drop) + "\n", {"simulation.settle_time=1"},
                  {"simulation.settle_time", "unknown key", "a mill key"});
+  // Snapshots are a mill's output; a scene writes its trajectory.
+  expect_refused(std::string(drop) + "\n", {"output.snapshot_format=vtk"},
+                 {"output.snapshot_format: unknown key (a mill key; a scene (a config without "
+                  "[mill]) does not use it)"});
 }
 
 TEST(SceneConfig, RefusesAVectorOfTheWrongLength) {
