@@ -10,10 +10,13 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <initializer_list>
+#include <iterator>
 #include <new>
 #include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <string_view>
@@ -122,23 +125,27 @@ void warn(const std::vector<std::string>& warnings, std::string_view context = {
   }
 }
 
+/// The files a mill run writes in its output directory (besides snapshots/).
+constexpr std::initializer_list<const char*> mill_result_names = {"summary.json",         "power.csv",
+                                                    "power_timeseries.csv", "spectrum.csv",
+                                                    "charge_profile.csv",   "impacts.csv"};
+
 /// Plans, places the charge, and only then creates the output directory, calls `started`,
 /// gives the plan's warnings and runs, so that a config that cannot run writes nothing and
 /// says nothing but why. The results' own warnings follow the run.
+/// `context` starts each warning of the plan and of the output directory (a sweep's point).
 template <int D>
 MillResult run_job(const MillPlan& plan, const std::string& out_location, bool show_progress,
-                   const std::function<void()>& started = {}) {
+                   const std::function<void()>& started = {}, std::string_view context = {}) {
   const MillConfig& config = plan.config;
   millsim::World<D> world = millsim::build_mill_world<D>(plan);
   const std::filesystem::path out = config.output_directory;
   const std::vector<std::string> cleared = prepare_output_directory(
-      out, out_location,
-      {"summary.json", "power.csv", "power_timeseries.csv", "spectrum.csv", "charge_profile.csv",
-       "impacts.csv"},
+      out, out_location, mill_result_names,
       config.snapshot_interval > 0.0 ? Snapshots::made : Snapshots::removed);
   if (started) started();
-  warn(cleared);
-  warn(plan.warnings);
+  warn(cleared, context);
+  warn(plan.warnings, context);
   const std::filesystem::path snapshots = out / "snapshots";
   ProgressLine progress(show_progress);
   MillResult result = millsim::run_mill(plan, std::move(world), snapshots, std::ref(progress));
@@ -480,45 +487,90 @@ std::vector<MillPlan> plan_sweep(const JobOptions& options,
   return plans;
 }
 
-/// Runs every planned point and returns its row. With at least as many points as threads the
-/// points run in parallel, one thread each (nesting is off, so the World's own parallel loops
-/// run serially) and without progress lines; otherwise one after another with every thread.
-/// The results are the same either way. A point that fails is reported in its row.
-std::vector<millsim::SweepRow> run_sweep(const std::vector<MillPlan>& plans,
-                                         const std::vector<millsim::SweepAxis>& axes,
-                                         const std::vector<std::vector<std::string>>& points,
-                                         bool quiet, bool parallel) {
-  std::vector<millsim::SweepRow> rows(points.size());
+/// Runs every planned point, filling in its row of `rows` (made pending), and rewrites
+/// sweep.csv at `table` as points finish (at most every few seconds, and not after the last:
+/// the caller writes the whole table). With at least as many points as threads the points run
+/// in parallel, one thread each (nesting is off, so the World's own parallel loops run
+/// serially) and without progress lines; otherwise one after another with every thread. The
+/// results are the same either way. A point that fails is reported in its row.
+void run_sweep(const std::vector<MillPlan>& plans, const std::vector<millsim::SweepAxis>& axes,
+               std::vector<millsim::SweepRow>& rows, const std::filesystem::path& table, bool quiet,
+               bool parallel) {
+  using Clock = std::chrono::steady_clock;
+  auto last_written = Clock::now();
   const auto run_point = [&](std::size_t i, bool show_progress) {
-    millsim::SweepRow& row = rows[i];
-    row.values = points[i];
+    millsim::SweepRow row = rows[i];
+    const MillPlan& plan = plans[i];
+    const std::string context = fmt::format("sweep point {}", row.directory);
+    row.warnings = plan.warnings;
     try {
-      const MillPlan& plan = plans[i];
-      const std::string location = fmt::format("sweep point {}", plan.config.output_directory);
       const MillResult result = plan.config.dimension == 2
-                                    ? run_job<2>(plan, location, show_progress)
-                                    : run_job<3>(plan, location, show_progress);
+                                    ? run_job<2>(plan, context, show_progress, {}, context)
+                                    : run_job<3>(plan, context, show_progress, {}, context);
       row.status = "ok";
       row.scalars = millsim::summary_scalars(result);
+      const std::vector<std::string> doubts = millsim::result_warnings(result);
+      row.warnings.insert(row.warnings.end(), doubts.begin(), doubts.end());
     } catch (const std::exception& error) {
       row.status = fmt::format("failed: {}", error.what());
     }
-    if (quiet) return;
 #pragma omp critical(millsim_sweep_report)
-    fmt::print(stderr, "point {} of {} done ({}): {}\n", i, points.size(),
-               fmt::join(millsim::point_overrides(axes, points[i]), ", "), row.status);
+    {
+      rows[i] = std::move(row);
+      // The table so far, for a sweep stopped before its end; a failure to write it here is
+      // left for the final write to report.
+      if (Clock::now() - last_written > std::chrono::seconds(2)) {
+        try {
+          millsim::write_sweep_csv(table, axes, rows);
+        } catch (const std::exception&) {
+        }
+        last_written = Clock::now();
+      }
+      if (!quiet) {
+        fmt::print(stderr, "point {} of {} done ({}): {}\n", i, rows.size(),
+                   fmt::join(millsim::point_overrides(axes, rows[i].values), ", "), rows[i].status);
+      }
+    }
   };
   if (!parallel) {
-    for (std::size_t i = 0; i < points.size(); ++i) run_point(i, !quiet);
-    return rows;
+    for (std::size_t i = 0; i < rows.size(); ++i) run_point(i, !quiet);
+    return;
   }
   const int levels = omp_get_max_active_levels();
   omp_set_max_active_levels(1);
-  const auto count = static_cast<std::ptrdiff_t>(points.size());
+  const auto count = static_cast<std::ptrdiff_t>(rows.size());
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::ptrdiff_t i = 0; i < count; ++i) run_point(static_cast<std::size_t>(i), false);
   omp_set_max_active_levels(levels);
-  return rows;
+}
+
+/// The whole text of a file (empty if it cannot be read).
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream file(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+/// The point directories an earlier sweep.csv in `root` lists (its `directory` column), each
+/// a plain name inside `root`; none if there is no such file or column.
+std::vector<std::string> earlier_point_directories(const std::filesystem::path& root) {
+  const std::filesystem::path path = root / "sweep.csv";
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) return {};
+  const std::vector<std::vector<std::string>> rows = millsim::csv_rows(read_text(path));
+  if (rows.empty()) return {};
+  const auto column = std::find(rows[0].begin(), rows[0].end(), "directory");
+  if (column == rows[0].end()) return {};
+  const auto k = static_cast<std::size_t>(column - rows[0].begin());
+  std::vector<std::string> names;
+  for (std::size_t r = 1; r < rows.size(); ++r) {
+    if (k >= rows[r].size()) continue;
+    const std::string& name = rows[r][k];
+    if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos) {
+      continue;
+    }
+    names.push_back(name);
+  }
+  return names;
 }
 
 /// Runs the cartesian product of the --vary axes, one output directory per point, writes
@@ -554,26 +606,55 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
   const std::vector<MillPlan> plans = plan_sweep(options, axes, points, root);
   const int threads = omp_get_max_threads();
   const bool parallel = threads > 1 && points.size() >= static_cast<std::size_t>(threads);
+  const std::string shown = (root / "").parent_path().string();  // without a trailing '/'
   if (!options.quiet) {
-    fmt::print("millsim: sweeping {} points of {} into {}/ ({})\n", points.size(),
-               plans.front().config.source, root.string(),
+    fmt::print("millsim: sweeping {} {} of {} into {}/ ({})\n", points.size(),
+               points.size() == 1 ? "point" : "points", plans.front().config.source, shown,
                parallel ? fmt::format("{} at a time", threads) : std::string("one at a time"));
     std::fflush(stdout);
   }
-  warn(prepare_output_directory(root,
-                                options.output_directory.empty()
-                                    ? std::string("the default output directory")
-                                    : fmt::format("command line (--out {})", root.string()),
-                                {"sweep.csv"}));
-  const std::vector<millsim::SweepRow> rows =
-      run_sweep(plans, axes, points, options.quiet, parallel);
-  millsim::write_sweep_csv(root / "sweep.csv", axes, rows);
+  // An earlier sweep into the same directory: the points its sweep.csv lists that this sweep
+  // does not have lose their results, as a run's earlier results go, so that the directory
+  // holds one sweep (a point this sweep has is cleared when it runs).
+  const std::vector<std::string> earlier = earlier_point_directories(root);
+  const std::string root_location = options.output_directory.empty()
+                                        ? std::string("the default output directory")
+                                        : fmt::format("command line (--out {})", root.string());
+  warn(prepare_output_directory(root, root_location, {"sweep.csv"}));
+  std::vector<millsim::SweepRow> rows(points.size());
+  std::set<std::string, std::less<>> current;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    rows[i].values = points[i];
+    rows[i].status = "pending";
+    rows[i].directory = std::filesystem::path(plans[i].config.output_directory).filename().string();
+    current.insert(rows[i].directory);
+  }
+  std::size_t removed = 0;
+  for (const std::string& name : earlier) {
+    std::error_code error;
+    if (current.contains(name) || !std::filesystem::is_directory(root / name, error)) continue;
+    warn(
+        prepare_output_directory(root / name, root_location, mill_result_names, Snapshots::removed),
+        fmt::format("earlier sweep's point {}", name));
+    std::filesystem::remove(root / name, error);  // only when nothing else is left in it
+    ++removed;
+  }
+  if (removed > 0 && !options.quiet) {
+    fmt::print(stderr, "millsim: removed the results of {} {} of the earlier sweep in {}/\n",
+               removed, removed == 1 ? "point" : "points", shown);
+  }
+  // The table from the start, every point pending, so that a sweep stopped early still says
+  // which directories are its own.
+  const std::filesystem::path table = root / "sweep.csv";
+  millsim::write_sweep_csv(table, axes, rows);
+  run_sweep(plans, axes, rows, table, options.quiet, parallel);
+  millsim::write_sweep_csv(table, axes, rows);
 
   fmt::print("{}", millsim::sweep_table(axes, rows));
   const auto failed = std::count_if(
       rows.begin(), rows.end(), [](const millsim::SweepRow& row) { return row.status != "ok"; });
   if (!options.quiet) {
-    fmt::print("results in {}/ (sweep.csv, one directory per point)\n", root.string());
+    fmt::print("results in {}/ (sweep.csv, one directory per point)\n", shown);
   }
   if (failed > 0) {
     fmt::print(stderr, "millsim: {} of {} points failed\n", failed, points.size());

@@ -149,6 +149,41 @@ TEST_F(SweepPowerCurve, AFailedPointIsReportedAndTheOthersStillRun) {
   EXPECT_NE(o.out.find("failed: "), std::string::npos) << o.out;
 }
 
+TEST_F(SweepPowerCurve, ASecondSweepIntoTheSameDirectoryReplacesTheFirst) {
+  const Outcome first =
+      millsim("sweep " + quoted(small_mill) + " --vary charge.filling=0.2,0.25,0.3 -q --out r" +
+              tiny_run + tiny_speed);
+  ASSERT_EQ(first.status, 0) << first.err;
+  // A file of the user's in a point directory of the first sweep: kept, with its directory.
+  std::ofstream(work_ / "r" / "002_charge.filling=0.3" / "notes.txt") << "mine\n";
+  const Outcome second = millsim("sweep " + quoted(small_mill) +
+                                 " --vary charge.filling=0.25 --out r" + tiny_run + tiny_speed);
+  ASSERT_EQ(second.status, 0) << second.err;
+  EXPECT_NE(second.err.find("millsim: removed the results of 3 points of the earlier sweep in r/"),
+            std::string::npos)
+      << second.err;
+  std::vector<std::string> names;
+  for (const auto& entry : fs::recursive_directory_iterator(work_ / "r")) {
+    names.push_back(fs::relative(entry.path(), work_ / "r").string());
+  }
+  std::sort(names.begin(), names.end());
+  ASSERT_GE(names.size(), 3U);
+  // Each of the first sweep's points has another name in the second (its index and value).
+  EXPECT_TRUE(std::find(names.begin(), names.end(), "000_charge.filling=0.2") == names.end());
+  EXPECT_TRUE(std::find(names.begin(), names.end(), "001_charge.filling=0.25") == names.end());
+  EXPECT_TRUE(std::find(names.begin(), names.end(), "002_charge.filling=0.3/notes.txt") !=
+              names.end());
+  EXPECT_TRUE(std::find(names.begin(), names.end(), "002_charge.filling=0.3/summary.json") ==
+              names.end());
+  EXPECT_TRUE(std::find(names.begin(), names.end(), "000_charge.filling=0.25/summary.json") !=
+              names.end());
+  // The table names each point's directory.
+  const auto rows = read_csv(work_ / "r" / "sweep.csv");
+  ASSERT_EQ(rows.size(), 1U);
+  EXPECT_EQ(rows[0].at("directory"), "000_charge.filling=0.25");
+  EXPECT_EQ(rows[0].at("status"), "ok");
+}
+
 TEST_F(SweepPowerCurve, AListValueMayHoldCommasInsideAnArray) {
   // Two size distributions: the commas inside each array belong to it, not to the list.
   const std::string one_size = "[{diameter = 0.025, mass_fraction = 1}]";

@@ -149,22 +149,80 @@ TEST(Sweep, DirectoryNamesAreIndexedReadableAndFilesystemSafe) {
 }
 
 TEST(Sweep, CsvHasOneRowPerPointAndEveryScalar) {
-  const std::vector<SweepAxis> axes{{"mill.speed", {"0.5", "0.7"}}};
+  const std::vector<SweepAxis> axes{{"mill.speed", {"0.5", "0.7", "0.9"}}};
   const std::vector<SweepRow> rows{
-      {{"0.5"}, "ok", {{"power_kw", 0.25}, {"empirical.bond_kw", 1.5}}},
-      {{"0.7"}, "failed: could not place 3 discs, \"try\" less", {}},
+      {{"0.5"},
+       "ok",
+       {{"power_kw", 0.25}, {"empirical.bond_kw", 1.5}},
+       "000_mill.speed=0.5",
+       {"a warning", "another, with a comma"}},
+      {{"0.7"}, "failed: could not place 3 discs, \"try\" less", {}, "001_mill.speed=0.7", {}},
+      {{"0.9"}, "pending", {}, "002_mill.speed=0.9", {}},
   };
   EXPECT_EQ(sweep_csv(axes, rows),
-            "point,mill.speed,status,power_kw,empirical.bond_kw\n"
-            "0,0.5,ok,0.25,1.5\n"
-            "1,0.7,\"failed: could not place 3 discs, \"\"try\"\" less\",,\n");
+            "point,directory,mill.speed,status,warnings,power_kw,empirical.bond_kw\n"
+            "0,000_mill.speed=0.5,0.5,ok,\"a warning; another, with a comma\",0.25,1.5\n"
+            "1,001_mill.speed=0.7,0.7,\"failed: could not place 3 discs, \"\"try\"\" less\",,,\n"
+            "2,002_mill.speed=0.9,0.9,pending,,,\n");
 }
 
-TEST(Sweep, CsvColumnsAreTheUnionOfTheRowsScalars) {
+TEST(Sweep, CsvColumnsKeepTheSummarysOrderWhicheverRowsHaveThem) {
+  // b is missing from the first row (a toe angle a centrifuging charge lacks, say): it still
+  // comes between a and c, as in the rows that have it, in whichever order the rows come.
   const std::vector<SweepAxis> axes{{"k", {"1", "2"}}};
-  const std::vector<SweepRow> rows{{{"1"}, "ok", {{"a", 1.0}}},
-                                   {{"2"}, "ok", {{"a", 2.0}, {"b", 0.1}}}};
-  EXPECT_EQ(sweep_csv(axes, rows), "point,k,status,a,b\n0,1,ok,1,\n1,2,ok,2,0.1\n");
+  const std::vector<SweepRow> without_first{
+      {{"1"}, "ok", {{"a", 1.0}, {"c", 3.0}}, "", {}},
+      {{"2"}, "ok", {{"a", 2.0}, {"b", 0.1}, {"c", 4.0}}, "", {}}};
+  const std::vector<SweepRow> with_first{
+      {{"2"}, "ok", {{"a", 2.0}, {"b", 0.1}, {"c", 4.0}}, "", {}},
+      {{"1"}, "ok", {{"a", 1.0}, {"c", 3.0}}, "", {}}};
+  EXPECT_EQ(sweep_csv(axes, without_first),
+            "point,directory,k,status,warnings,a,b,c\n0,,1,ok,,1,,3\n1,,2,ok,,2,0.1,4\n");
+  EXPECT_EQ(sweep_csv(axes, with_first),
+            "point,directory,k,status,warnings,a,b,c\n0,,2,ok,,2,0.1,4\n1,,1,ok,,1,,3\n");
+  // A name the first row lacks at its start, and one at its end.
+  const std::vector<SweepRow> ends{{{"1"}, "ok", {{"b", 1.0}}, "", {}},
+                                   {{"2"}, "ok", {{"a", 2.0}, {"b", 3.0}, {"c", 4.0}}, "", {}}};
+  EXPECT_TRUE(sweep_csv(axes, ends).starts_with("point,directory,k,status,warnings,a,b,c\n"));
+}
+
+TEST(Sweep, CsvRowsReadBackWhatCsvLineWrites) {
+  const std::vector<std::string> cells{"plain", "a, b", "say \"hi\"", "two\nlines", ""};
+  const std::string text = csv_line(cells) + "x,y\r\nlast";
+  const std::vector<std::vector<std::string>> rows = csv_rows(text);
+  ASSERT_EQ(rows.size(), 3U);
+  EXPECT_EQ(rows[0], cells);
+  EXPECT_EQ(rows[1], (std::vector<std::string>{"x", "y"}));
+  EXPECT_EQ(rows[2], (std::vector<std::string>{"last"}));
+  EXPECT_TRUE(csv_rows("").empty());
+}
+
+TEST(Sweep, ALongValueIsCutInTheDirectoryNameAndHashed) {
+  const std::vector<SweepAxis> axes{{"charge.sizes", {}}};
+  const std::string sizes_a =
+      "[{diameter = 0.1, mass_fraction = 0.2}, {diameter = 0.08, mass_fraction = 0.2}, "
+      "{diameter = 0.06, mass_fraction = 0.2}, {diameter = 0.05, mass_fraction = 0.2}, "
+      "{diameter = 0.04, mass_fraction = 0.2}]";
+  std::string sizes_b = sizes_a;
+  sizes_b[sizes_b.size() - 3] = '1';  // the last fraction, beyond the cut
+  const std::string a = point_directory_name(0, 2, axes, {sizes_a});
+  const std::string b = point_directory_name(0, 2, axes, {sizes_b});
+  EXPECT_EQ(a.size(), 3 + longest_point_values);
+  EXPECT_EQ(a.substr(0, 40), "000_charge.sizes=__diameter_=_0.1__mass_");
+  EXPECT_NE(a, b) << "the hash tells values apart that the cut does not";
+  EXPECT_EQ(a.substr(0, a.size() - 8), b.substr(0, b.size() - 8));
+  EXPECT_EQ(a, point_directory_name(0, 2, axes, {sizes_a})) << "the same name every time";
+}
+
+TEST(Sweep, TooManyValuesAreCountedExactly) {
+  try {
+    (void)parse_vary("mill.speed=0:1:0.0001");
+    ADD_FAILURE() << "10 001 values taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(": 10001 values; allowed: at most 10000 values"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Sweep, TableShowsPowersAndStatus) {
@@ -172,8 +230,10 @@ TEST(Sweep, TableShowsPowersAndStatus) {
   const std::vector<SweepRow> rows{
       {{"0.5"},
        "ok",
-       {{"power_kw", 0.25}, {"power_dissipation_kw", 0.26}, {"energy_balance_error", 0.001}}},
-      {{"0.7"}, "failed: boom", {}},
+       {{"power_kw", 0.25}, {"power_dissipation_kw", 0.26}, {"energy_balance_error", 0.001}},
+       "",
+       {}},
+      {{"0.7"}, "failed: boom", {}, "", {}},
   };
   const std::string table = sweep_table(axes, rows);
   for (const char* part : {"mill.speed", "power_kw", "power_dissipation_kw", "energy_balance_error",

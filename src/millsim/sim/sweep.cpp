@@ -6,6 +6,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <set>
@@ -16,6 +17,11 @@
 
 namespace millsim {
 namespace {
+
+/// A count as a whole number, or in powers of ten when it has too many digits to read.
+std::string count_text(double count) {
+  return count < 1e15 ? fmt::format("{:.0f}", count) : fmt::format("{:.3g}", count);
+}
 
 constexpr std::string_view vary_allowed =
     "KEY=START:STOP:STEP (numbers; STEP not 0 and leading from START towards STOP) or "
@@ -127,8 +133,8 @@ std::vector<std::string> range_values(const std::vector<std::string>& parts,
   }
   const double last = std::floor(steps + stop_tolerance_steps * std::max(1.0, steps));
   if (last + 1.0 > static_cast<double>(max_sweep_points)) {
-    throw InputError(fmt::format("{}: {:.3g} values; allowed: at most {} values", where, last + 1.0,
-                                 max_sweep_points));
+    throw InputError(fmt::format("{}: {} values; allowed: at most {} values", where,
+                                 count_text(last + 1.0), max_sweep_points));
   }
   const int decimals = std::max(decimal_places(parts[0]), decimal_places(parts[2]));
   std::vector<std::string> values;
@@ -158,6 +164,16 @@ std::string csv_field(const std::string& text) {
     quoted += c;
   }
   return quoted + "\"";
+}
+
+/// A name's characters hashed (32-bit FNV-1a), the same on every machine and run.
+std::uint32_t stable_hash(std::string_view text) {
+  std::uint32_t hash = 2166136261U;
+  for (const char c : text) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 16777619U;
+  }
+  return hash;
 }
 
 }  // namespace
@@ -249,8 +265,8 @@ void check_sweep_axes(const std::vector<SweepAxis>& axes) {
     }
   }
   if (count > static_cast<double>(max_sweep_points)) {
-    throw InputError(fmt::format("command line (--vary): {:.3g} points; allowed: at most {}", count,
-                                 max_sweep_points));
+    throw InputError(fmt::format("command line (--vary): {} points; allowed: at most {}",
+                                 count_text(count), max_sweep_points));
   }
 }
 
@@ -283,38 +299,59 @@ std::string point_directory_name(std::size_t index, std::size_t count,
                                  const std::vector<SweepAxis>& axes,
                                  const std::vector<std::string>& point) {
   const std::size_t width = std::max<std::size_t>(3, fmt::format("{}", count - 1).size());
-  std::string name = fmt::format("{:0{}d}", index, width);
+  std::string values;
   for (const std::string& setting : point_overrides(axes, point)) {
-    name += '_';
+    values += '_';
     for (const char c : setting) {
       const bool safe = std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '.' || c == '+' ||
                         c == '-' || c == '=' || c == '_';
-      name += safe ? c : '_';
+      values += safe ? c : '_';
     }
   }
-  return name;
+  // A long value (a list of size classes, say) is cut, and a hash of the whole keeps names
+  // apart, within the 255 bytes a file name may have; sweep.csv has the whole values.
+  if (values.size() > longest_point_values) {
+    values =
+        fmt::format("{}_{:08x}", values.substr(0, longest_point_values - 9), stable_hash(values));
+  }
+  return fmt::format("{:0{}d}", index, width) + values;
 }
 
 std::string sweep_csv(const std::vector<SweepAxis>& axes, const std::vector<SweepRow>& rows) {
+  // Every row lists its scalars in summary_scalars order, leaving out those it does not have:
+  // each new name goes in right after the name before it in its row, so that the columns keep
+  // that order whichever rows have which.
   std::vector<std::string> names;
-  std::set<std::string, std::less<>> seen;
   for (const SweepRow& row : rows) {
+    std::size_t at = 0;
     for (const auto& entry : row.scalars) {
-      if (seen.insert(entry.first).second) names.push_back(entry.first);
+      const auto found = std::find(names.begin(), names.end(), entry.first);
+      if (found == names.end()) {
+        names.insert(names.begin() + static_cast<std::ptrdiff_t>(at), entry.first);
+        ++at;
+      } else {
+        at = static_cast<std::size_t>(found - names.begin()) + 1;
+      }
     }
   }
-  std::vector<std::string> header{"point"};
+  std::vector<std::string> header{"point", "directory"};
   for (const SweepAxis& axis : axes) header.push_back(axis.key);
   header.emplace_back("status");
+  header.emplace_back("warnings");
   header.insert(header.end(), names.begin(), names.end());
   std::string text = csv_line(header);
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const SweepRow& row = rows[i];
     std::map<std::string_view, double, std::less<>> values;
     for (const auto& [name, value] : row.scalars) values.emplace(name, value);
-    std::vector<std::string> cells{fmt::format("{}", i)};
+    std::vector<std::string> cells{fmt::format("{}", i), row.directory};
     cells.insert(cells.end(), row.values.begin(), row.values.end());
     cells.push_back(row.status);
+    std::string warnings;
+    for (const std::string& warning : row.warnings) {
+      warnings += (warnings.empty() ? "" : "; ") + warning;
+    }
+    cells.push_back(warnings);
     for (const std::string& name : names) {
       const auto found = values.find(name);
       cells.push_back(found == values.end() ? std::string() : fmt::format("{}", found->second));
@@ -322,6 +359,49 @@ std::string sweep_csv(const std::vector<SweepAxis>& axes, const std::vector<Swee
     text += csv_line(cells);
   }
   return text;
+}
+
+std::vector<std::vector<std::string>> csv_rows(std::string_view text) {
+  std::vector<std::vector<std::string>> rows;
+  std::vector<std::string> row;
+  std::string cell;
+  bool quoted = false;
+  bool cell_started = false;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    const char c = text[k];
+    if (quoted) {
+      if (c != '"') {
+        cell += c;
+      } else if (k + 1 < text.size() && text[k + 1] == '"') {
+        cell += '"';
+        ++k;
+      } else {
+        quoted = false;
+      }
+    } else if (c == '"' && !cell_started) {
+      quoted = true;
+      cell_started = true;
+    } else if (c == ',') {
+      row.push_back(std::move(cell));
+      cell.clear();
+      cell_started = false;
+    } else if (c == '\n' || c == '\r') {
+      if (c == '\r' && k + 1 < text.size() && text[k + 1] == '\n') ++k;
+      row.push_back(std::move(cell));
+      rows.push_back(std::move(row));
+      row.clear();
+      cell.clear();
+      cell_started = false;
+    } else {
+      cell += c;
+      cell_started = true;
+    }
+  }
+  if (cell_started || !row.empty()) {
+    row.push_back(std::move(cell));
+    rows.push_back(std::move(row));
+  }
+  return rows;
 }
 
 void write_sweep_csv(const std::filesystem::path& path, const std::vector<SweepAxis>& axes,

@@ -47,30 +47,43 @@ std::vector<std::vector<std::string>> cartesian_product(const std::vector<SweepA
 std::vector<std::string> point_overrides(const std::vector<SweepAxis>& axes,
                                          const std::vector<std::string>& point);
 
+/// The longest the `_KEY=VALUE` part of a point's directory name may be (point_directory_name).
+inline constexpr std::size_t longest_point_values = 120;
+
 /// The directory of point `index` of `count`: the zero-padded index (at least 3 digits), then
 /// `_KEY=VALUE` per axis, with every character other than letters, digits and `.+-=_` made
-/// `_`, e.g. "007_mill.speed=0.7_charge.filling=0.3". The index makes names unique.
+/// `_`, e.g. "007_mill.speed=0.7_charge.filling=0.3". The index makes names unique. Values
+/// longer than longest_point_values in all are cut there, ending in `_` and 8 hex digits of a
+/// hash of the whole.
 std::string point_directory_name(std::size_t index, std::size_t count,
                                  const std::vector<SweepAxis>& axes,
                                  const std::vector<std::string>& point);
 
-/// The outcome of one point: its values, "ok" or "failed: message", and (when it ran) every
-/// scalar of its summary in summary_scalars order.
+/// The outcome of one point: its values, "ok", "failed: message" or "pending" (not yet run),
+/// and (when it ran) every scalar of its summary in summary_scalars order; its directory's
+/// name, and what made its results doubtful (its plan's and its results' warnings).
 struct SweepRow {
   std::vector<std::string> values;
   std::string status;
   std::vector<std::pair<std::string, double>> scalars;
+  std::string directory;
+  std::vector<std::string> warnings;
 };
 
 /// One CSV line of `cells`, ended by a line break; a cell with a comma, quote or line break is
 /// quoted (RFC 4180).
 std::string csv_line(const std::vector<std::string>& cells);
 
-/// sweep.csv: a header `point, <each key>, status, <each scalar name>`, then one row per point.
-/// The scalar columns are the names of all rows in order of first appearance; a row without a
-/// scalar (a failed point) leaves its cell empty. Fields with a comma, quote or line break are
-/// quoted (RFC 4180).
+/// sweep.csv: a header `point, directory, <each key>, status, warnings, <each scalar name>`,
+/// then one row per point. The scalar columns are the names of all rows, in the order the
+/// rows list them (summary_scalars's, whichever rows have which); a row without a scalar (a
+/// failed point, a toe angle a centrifuging charge lacks) leaves its cell empty. Warnings are
+/// joined by "; ". Fields with a comma, quote or line break are quoted (RFC 4180).
 std::string sweep_csv(const std::vector<SweepAxis>& axes, const std::vector<SweepRow>& rows);
+
+/// The rows of CSV text, each split into its fields (RFC 4180: quoted fields may hold commas,
+/// doubled quotes and line breaks).
+std::vector<std::vector<std::string>> csv_rows(std::string_view text);
 
 /// Writes sweep_csv(axes, rows) to `path` under a temporary name (`path`.partial) and renames
 /// it, so that a half-written file never appears. Throws std::runtime_error if it cannot.
