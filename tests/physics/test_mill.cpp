@@ -18,6 +18,7 @@
 #include "millsim/io/output.hpp"
 #include "millsim/sim/mill_run.hpp"
 #include "support/energy_account.hpp"
+#include "support/temporary_directory.hpp"
 
 namespace millsim {
 namespace {
@@ -166,10 +167,8 @@ TEST(Mill, SnapshotVelocitiesAreAtTheTimeOfThePositions) {
   // positions (the leapfrog's own) would miss both by g Δt / 2, 2e-4 m/s here.
   const MillPlan plan = plan_mill(lab_mill());
   World<2> world = build_mill_world<2>(plan);
-  std::string pattern =
-      (std::filesystem::temp_directory_path() / "millsim-snapshot-motion-XXXXXX").string();
-  ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-  const std::filesystem::path directory = pattern;
+  const std::filesystem::path directory = testing::fresh_directory("snapshot-motion");
+  ASSERT_FALSE(directory.empty());
   {
     SnapshotWriter snapshots(directory);
     while (world.time() < 0.004) world.step();
@@ -214,10 +213,8 @@ TEST(Mill, ARunWritesThePlannedSnapshotsInLessThanThePlannedBytes) {
     overrides.insert(overrides.end(), extra.begin(), extra.end());
     const MillPlan plan =
         plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", overrides));
-    std::string pattern =
-        (std::filesystem::temp_directory_path() / "millsim-snapshot-count-XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    const std::filesystem::path directory = pattern;
+    const std::filesystem::path directory = testing::fresh_directory("snapshot-count");
+    ASSERT_FALSE(directory.empty());
     (void)run_mill(plan, build_mill_world<2>(plan), directory);
     const auto index = csv_numbers(directory / "index.csv");
     EXPECT_EQ(static_cast<double>(index.size()), plan.snapshot_count) << extra.back();

@@ -19,6 +19,7 @@
 #include "millsim/core/constants.hpp"
 #include "millsim/particles/material.hpp"
 #include "physics/impact_answers.hpp"
+#include "support/temporary_directory.hpp"
 
 namespace {
 
@@ -72,9 +73,8 @@ Table read_csv(const fs::path& path) {
 class VerificationScene : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "millsim-verify-XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    root_ = pattern;
+    root_ = millsim::testing::fresh_directory("verify");
+    ASSERT_FALSE(root_.empty());
   }
   void TearDown() override {
     std::error_code ignored;

@@ -12,6 +12,8 @@
 #include <iterator>
 #include <string>
 
+#include "support/temporary_directory.hpp"
+
 namespace millsim::testing {
 
 /// `text` as one single-quoted shell word.
@@ -35,9 +37,8 @@ struct Outcome {
 class ProgramTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string pattern = (std::filesystem::temp_directory_path() / "millsim-test-XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    root_ = pattern;
+    root_ = fresh_directory("test");
+    ASSERT_FALSE(root_.empty());
     work_ = root_ / "work";
     std::filesystem::create_directory(work_);
   }

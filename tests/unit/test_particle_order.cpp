@@ -20,6 +20,7 @@
 #include "millsim/sim/charge.hpp"
 #include "millsim/sim/scene_run.hpp"
 #include "millsim/sim/world.hpp"
+#include "support/temporary_directory.hpp"
 
 namespace millsim {
 namespace {
@@ -42,15 +43,6 @@ std::size_t renumbered(const World<2>& world) {
     moved += world.particle_id(i) != i ? 1 : 0;
   }
   return moved;
-}
-
-/// A directory of its own under the system's temporary directory (test programs may run at
-/// the same time).
-std::filesystem::path fresh_directory() {
-  std::string pattern =
-      (std::filesystem::temp_directory_path() / "millsim-particle-order-XXXXXX").string();
-  EXPECT_NE(mkdtemp(pattern.data()), nullptr);
-  return pattern;
 }
 
 /// The lines of a text file.
@@ -120,7 +112,7 @@ TEST(ParticleOrder, RenumberedParticlesKeepTheirIdsContactsAndPhysics) {
 TEST(ParticleOrder, SnapshotListsParticlesById) {
   const World<2> world = falling_charge(1, 1000);
   ASSERT_GT(renumbered(world), 0u);
-  const std::filesystem::path directory = fresh_directory();
+  const std::filesystem::path directory = testing::fresh_directory("particle-order");
   {
     SnapshotWriter snapshots(directory);
     snapshots.write(world);
@@ -175,7 +167,7 @@ trajectory_interval = 0.005
   world.step();
   EXPECT_EQ(renumbered(world), static_cast<std::size_t>(count)) << "reversed by the cell order";
 
-  const std::filesystem::path directory = fresh_directory();
+  const std::filesystem::path directory = testing::fresh_directory("particle-order");
   run_scene(plan, directory);
   const std::vector<std::string> final_rows = lines_of(directory / "final.csv");
   ASSERT_EQ(final_rows.size(), static_cast<std::size_t>(count + 1));

@@ -19,6 +19,7 @@
 #include "millsim/core/version.hpp"
 #include "millsim/io/config.hpp"
 #include "millsim/sim/scene_run.hpp"
+#include "support/temporary_directory.hpp"
 
 namespace {
 
@@ -292,9 +293,8 @@ int millsim_in(const std::filesystem::path& directory, const std::string& args) 
 
 TEST(SceneRun, WritesTrajectoryFinalAndSummaryAndNothingPartial) {
   namespace fs = std::filesystem;
-  std::string pattern = (fs::temp_directory_path() / "millsim-scene-XXXXXX").string();
-  ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-  const fs::path work = pattern;
+  const fs::path work = millsim::testing::fresh_directory("scene");
+  ASSERT_FALSE(work.empty());
   std::ofstream(work / "drop.toml") << drop;
   ASSERT_EQ(millsim_in(work, "run drop.toml -q --out out"), 0);
   for (const char* name : {"trajectory.csv", "final.csv", "summary.json"}) {

@@ -25,6 +25,7 @@
 #include "millsim/io/vtk_output.hpp"
 #include "millsim/sim/charge.hpp"
 #include "support/program_test.hpp"
+#include "support/temporary_directory.hpp"
 
 namespace millsim {
 namespace {
@@ -338,15 +339,8 @@ TEST(VtkOutput, PolygonsFaceOutOfTheMillAndOutOfEachLiftersBox) {
   }
 }
 
-/// A directory of its own under the system's temporary directory.
-std::filesystem::path fresh_directory() {
-  std::string pattern = (std::filesystem::temp_directory_path() / "millsim-vtk-XXXXXX").string();
-  EXPECT_NE(mkdtemp(pattern.data()), nullptr);
-  return pattern;
-}
-
 TEST(VtkOutput, TheCollectionIsWholeAfterEverySnapshot) {
-  const std::filesystem::path directory = fresh_directory();
+  const std::filesystem::path directory = testing::fresh_directory("vtk");
   const std::filesystem::path path = directory / "snapshots.pvd";
   {
     PvdCollection collection(path);
@@ -373,7 +367,7 @@ TEST(VtkOutput, TheCollectionIsWholeAfterEverySnapshot) {
 TEST(VtkOutput, ACollectionWhoseWriteFailsIsLeftWholeWithWhatItListed) {
   // A file-size limit the collection's third entry passes (SIGXFSZ ignored, so that the write
   // fails with EFBIG instead of ending the process).
-  const std::filesystem::path directory = fresh_directory();
+  const std::filesystem::path directory = testing::fresh_directory("vtk");
   const std::filesystem::path path = directory / "particles.pvd";
   const std::string entry = "snapshot_000000.vtp";
   rlimit saved{};
@@ -404,7 +398,7 @@ TEST(VtkOutput, ACollectionWhoseWriteFailsIsLeftWholeWithWhatItListed) {
 }
 
 TEST(VtkOutput, AFileWhoseWriteFailsSaysWhy) {
-  const std::filesystem::path directory = fresh_directory();
+  const std::filesystem::path directory = testing::fresh_directory("vtk");
   rlimit saved{};
   ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved), 0);
   const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
@@ -426,7 +420,7 @@ TEST(VtkOutput, AFileWhoseWriteFailsSaysWhy) {
 }
 
 TEST(VtkOutput, SnapshotsInVtkOnlyWriteNoTableAndTheIndexNamesTheirFiles) {
-  const std::filesystem::path directory = fresh_directory();
+  const std::filesystem::path directory = testing::fresh_directory("vtk");
   World<2> world = example_world<2>({}, 0);
   {
     SnapshotWriter snapshots(directory, false, true);
