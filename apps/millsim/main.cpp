@@ -126,9 +126,9 @@ void warn(const std::vector<std::string>& warnings, std::string_view context = {
 }
 
 /// The files a mill run writes in its output directory (besides snapshots/).
-constexpr std::initializer_list<const char*> mill_result_names = {"summary.json",         "power.csv",
-                                                    "power_timeseries.csv", "spectrum.csv",
-                                                    "charge_profile.csv",   "impacts.csv"};
+constexpr std::initializer_list<const char*> mill_result_names = {
+    "summary.json", "power.csv",          "power_timeseries.csv",
+    "spectrum.csv", "charge_profile.csv", "impacts.csv"};
 
 /// Plans, places the charge, and only then creates the output directory, calls `started`,
 /// gives the plan's warnings and runs, so that a config that cannot run writes nothing and
@@ -488,27 +488,30 @@ std::vector<MillPlan> plan_sweep(const JobOptions& options,
 }
 
 /// Runs every planned point, filling in its row of `rows` (made pending), and rewrites
-/// sweep.csv at `table` as points finish (at most every few seconds, and not after the last:
-/// the caller writes the whole table). With at least as many points as threads the points run
-/// in parallel, one thread each (nesting is off, so the World's own parallel loops run
-/// serially) and without progress lines; otherwise one after another with every thread. The
-/// results are the same either way. A point that fails is reported in its row.
+/// sweep.csv at `table` as points finish (after each, unless writing it takes more than a
+/// twentieth of the time between: a sweep of many quick points), not after the last: the
+/// caller writes the whole table. With at least as many points as threads the points run in
+/// parallel, one thread each (nesting is off, so the World's own parallel loops run serially)
+/// and without progress lines; otherwise one after another with every thread. The results are
+/// the same either way. A point that fails is reported in its row.
 void run_sweep(const std::vector<MillPlan>& plans, const std::vector<millsim::SweepAxis>& axes,
                std::vector<millsim::SweepRow>& rows, const std::filesystem::path& table, bool quiet,
                bool parallel) {
   using Clock = std::chrono::steady_clock;
   auto last_written = Clock::now();
+  Clock::duration writing{};  // how long the last rewrite took
   const auto run_point = [&](std::size_t i, bool show_progress) {
     millsim::SweepRow row = rows[i];
     const MillPlan& plan = plans[i];
     const std::string context = fmt::format("sweep point {}", row.directory);
-    row.warnings = plan.warnings;
     try {
       const MillResult result = plan.config.dimension == 2
                                     ? run_job<2>(plan, context, show_progress, {}, context)
                                     : run_job<3>(plan, context, show_progress, {}, context);
       row.status = "ok";
-      row.scalars = millsim::summary_scalars(result);
+      row.scalars = millsim::summary_columns(result);
+      // What the run warned of: its plan's doubts, then its results'.
+      row.warnings = plan.warnings;
       const std::vector<std::string> doubts = millsim::result_warnings(result);
       row.warnings.insert(row.warnings.end(), doubts.begin(), doubts.end());
     } catch (const std::exception& error) {
@@ -517,18 +520,21 @@ void run_sweep(const std::vector<MillPlan>& plans, const std::vector<millsim::Sw
 #pragma omp critical(millsim_sweep_report)
     {
       rows[i] = std::move(row);
-      // The table so far, for a sweep stopped before its end; a failure to write it here is
-      // left for the final write to report.
-      if (Clock::now() - last_written > std::chrono::seconds(2)) {
-        try {
+      // Nothing may leave a parallel region: a table or a line that cannot be written here is
+      // left for the final table, written after the region, to report.
+      try {
+        const auto now = Clock::now();
+        if (now - last_written >= 20 * writing) {
           millsim::write_sweep_csv(table, axes, rows);
-        } catch (const std::exception&) {
+          last_written = Clock::now();
+          writing = last_written - now;
         }
-        last_written = Clock::now();
-      }
-      if (!quiet) {
-        fmt::print(stderr, "point {} of {} done ({}): {}\n", i, rows.size(),
-                   fmt::join(millsim::point_overrides(axes, rows[i].values), ", "), rows[i].status);
+        if (!quiet) {
+          fmt::print(stderr, "point {} of {} done ({}): {}\n", i, rows.size(),
+                     fmt::join(millsim::point_overrides(axes, rows[i].values), ", "),
+                     rows[i].status);
+        }
+      } catch (...) {
       }
     }
   };
@@ -550,25 +556,38 @@ std::string read_text(const std::filesystem::path& path) {
   return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
 }
 
-/// The point directories an earlier sweep.csv in `root` lists (its `directory` column), each
-/// a plain name inside `root`; none if there is no such file or column.
+/// The point directories of the earlier sweep whose sweep.csv is in `root`: each row's name as
+/// point_directory_name makes it from the row's index and values (the columns between `point`,
+/// or `directory`, and `status` are the varied keys), where the row's `directory` cell, if the
+/// table has that column, is the same name; and only those that are directories, not links.
+/// So a table edited by hand, or copied from elsewhere, names nothing but point directories.
 std::vector<std::string> earlier_point_directories(const std::filesystem::path& root) {
   const std::filesystem::path path = root / "sweep.csv";
   std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) return {};
+  if (!std::filesystem::is_regular_file(std::filesystem::symlink_status(path, error))) return {};
   const std::vector<std::vector<std::string>> rows = millsim::csv_rows(read_text(path));
-  if (rows.empty()) return {};
-  const auto column = std::find(rows[0].begin(), rows[0].end(), "directory");
-  if (column == rows[0].end()) return {};
-  const auto k = static_cast<std::size_t>(column - rows[0].begin());
+  if (rows.size() < 2 || rows[0].empty() || rows[0][0] != "point") return {};
+  const std::vector<std::string>& header = rows[0];
+  const bool listed = header.size() > 1 && header[1] == "directory";
+  const std::size_t first_key = listed ? 2 : 1;
+  const auto status = std::find(header.begin(), header.end(), "status");
+  if (status == header.end()) return {};
+  const auto end_key = static_cast<std::size_t>(status - header.begin());
+  if (end_key < first_key) return {};
+  std::vector<millsim::SweepAxis> axes;
+  for (std::size_t k = first_key; k < end_key; ++k) axes.push_back({header[k], {}});
+  const std::size_t count = rows.size() - 1;
   std::vector<std::string> names;
   for (std::size_t r = 1; r < rows.size(); ++r) {
-    if (k >= rows[r].size()) continue;
-    const std::string& name = rows[r][k];
-    if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos) {
-      continue;
+    const std::vector<std::string>& row = rows[r];
+    if (row.size() != header.size() || row[0] != fmt::format("{}", r - 1)) continue;
+    const std::vector<std::string> values(row.begin() + static_cast<std::ptrdiff_t>(first_key),
+                                          row.begin() + static_cast<std::ptrdiff_t>(end_key));
+    const std::string name = millsim::point_directory_name(r - 1, count, axes, values);
+    if (listed && row[1] != name) continue;
+    if (std::filesystem::is_directory(std::filesystem::symlink_status(root / name, error))) {
+      names.push_back(name);
     }
-    names.push_back(name);
   }
   return names;
 }
@@ -613,14 +632,13 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
                parallel ? fmt::format("{} at a time", threads) : std::string("one at a time"));
     std::fflush(stdout);
   }
-  // An earlier sweep into the same directory: the points its sweep.csv lists that this sweep
-  // does not have lose their results, as a run's earlier results go, so that the directory
-  // holds one sweep (a point this sweep has is cleared when it runs).
-  const std::vector<std::string> earlier = earlier_point_directories(root);
+  // An earlier sweep into the same directory (its sweep.csv): its points that this sweep does
+  // not have lose their results, as a run's earlier results go, and so do this sweep's own
+  // points' directories, so that the directory holds one sweep and a point not yet run holds
+  // nothing. The earlier table goes last, so that a refusal here leaves it listing what is left.
   const std::string root_location = options.output_directory.empty()
                                         ? std::string("the default output directory")
                                         : fmt::format("command line (--out {})", root.string());
-  warn(prepare_output_directory(root, root_location, {"sweep.csv"}));
   std::vector<millsim::SweepRow> rows(points.size());
   std::set<std::string, std::less<>> current;
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -629,28 +647,41 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
     rows[i].directory = std::filesystem::path(plans[i].config.output_directory).filename().string();
     current.insert(rows[i].directory);
   }
-  std::size_t removed = 0;
-  for (const std::string& name : earlier) {
+  std::set<std::string, std::less<>> removed;
+  for (const std::string& name : earlier_point_directories(root)) {
+    if (current.contains(name) || removed.contains(name)) continue;
+    const std::string context = fmt::format("{}, a point of the earlier sweep", root_location);
+    warn(prepare_output_directory(root / name, context, mill_result_names, Snapshots::removed),
+         context);
     std::error_code error;
-    if (current.contains(name) || !std::filesystem::is_directory(root / name, error)) continue;
+    std::filesystem::remove(root / name, error);  // only when nothing else is left in it
+    removed.insert(name);
+  }
+  for (const std::string& name : current) {
+    std::error_code error;
+    if (!std::filesystem::is_directory(std::filesystem::symlink_status(root / name, error))) {
+      continue;
+    }
     warn(
         prepare_output_directory(root / name, root_location, mill_result_names, Snapshots::removed),
-        fmt::format("earlier sweep's point {}", name));
-    std::filesystem::remove(root / name, error);  // only when nothing else is left in it
-    ++removed;
+        fmt::format("sweep point {}", name));
   }
-  if (removed > 0 && !options.quiet) {
+  warn(prepare_output_directory(root, root_location, {"sweep.csv"}));
+  if (!removed.empty() && !options.quiet) {
     fmt::print(stderr, "millsim: removed the results of {} {} of the earlier sweep in {}/\n",
-               removed, removed == 1 ? "point" : "points", shown);
+               removed.size(), removed.size() == 1 ? "point" : "points", shown);
   }
   // The table from the start, every point pending, so that a sweep stopped early still says
-  // which directories are its own.
+  // which directories are its own and which points finished.
   const std::filesystem::path table = root / "sweep.csv";
   millsim::write_sweep_csv(table, axes, rows);
   run_sweep(plans, axes, rows, table, options.quiet, parallel);
-  millsim::write_sweep_csv(table, axes, rows);
 
+  // The table on stdout first: a sweep.csv that cannot be written fails the command after the
+  // results are shown.
   fmt::print("{}", millsim::sweep_table(axes, rows));
+  std::fflush(stdout);
+  millsim::write_sweep_csv(table, axes, rows);
   const auto failed = std::count_if(
       rows.begin(), rows.end(), [](const millsim::SweepRow& row) { return row.status != "ok"; });
   if (!options.quiet) {

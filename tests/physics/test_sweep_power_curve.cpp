@@ -101,6 +101,10 @@ TEST_F(SweepPowerCurve, PowerRisesToAPeakBelowCriticalAndFallsAsTheChargeCentrif
   EXPECT_LT(power.front(), power[peak]) << curve;
   EXPECT_GE(speed.back(), 1.3);
   EXPECT_LT(power.back(), 0.3 * power[peak]) << curve;
+  // The centrifuged charge at twice critical speed has no toe: its cell is empty, in the same
+  // column as the tumbling charges' toes (read_csv checks every row has every column).
+  EXPECT_FALSE(rows.front().at("charge_toe_angle_rad").empty());
+  EXPECT_EQ(rows.back().at("charge_toe_angle_rad"), "");
 }
 
 TEST_F(SweepPowerCurve, ResultsDoNotDependOnTheThreadsAndEveryPointHasItsDirectory) {
@@ -182,6 +186,49 @@ TEST_F(SweepPowerCurve, ASecondSweepIntoTheSameDirectoryReplacesTheFirst) {
   ASSERT_EQ(rows.size(), 1U);
   EXPECT_EQ(rows[0].at("directory"), "000_charge.filling=0.25");
   EXPECT_EQ(rows[0].at("status"), "ok");
+}
+
+TEST_F(SweepPowerCurve, AnEarlierTableNamesNothingButItsOwnPointDirectories) {
+  // A table edited by hand: rows naming a directory of the user's, a link out of --out, and a
+  // point directory under a name its row's values do not give. None is touched.
+  fs::create_directories(work_ / "u" / "analysis" / "snapshots");
+  std::ofstream(work_ / "u" / "analysis" / "impacts.csv") << "mine\n";
+  std::ofstream(work_ / "u" / "analysis" / "snapshots" / "figure.png") << "mine\n";
+  fs::create_directories(work_ / "elsewhere");
+  std::ofstream(work_ / "elsewhere" / "summary.json") << "mine\n";
+  fs::create_directory_symlink(work_ / "elsewhere", work_ / "u" / "link");
+  fs::create_directories(work_ / "u" / "001_mill.speed=0.6");
+  std::ofstream(work_ / "u" / "001_mill.speed=0.6" / "summary.json") << "mine\n";
+  std::ofstream(work_ / "u" / "sweep.csv") << "point,directory,mill.speed,status\n"
+                                           << "0,analysis,0.5,ok\n"
+                                           << "1,link,0.6,ok\n"
+                                           << "2,001_mill.speed=0.6,0.6,ok\n";
+  const Outcome o = millsim("sweep " + quoted(small_mill) +
+                            " --vary charge.filling=0.25 -q --out u" + tiny_run + tiny_speed);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_EQ(read_all(work_ / "u" / "analysis" / "impacts.csv"), "mine\n");
+  EXPECT_EQ(read_all(work_ / "u" / "analysis" / "snapshots" / "figure.png"), "mine\n");
+  EXPECT_EQ(read_all(work_ / "elsewhere" / "summary.json"), "mine\n");
+  EXPECT_EQ(read_all(work_ / "u" / "001_mill.speed=0.6" / "summary.json"), "mine\n");
+  EXPECT_EQ(o.err.find("removed the results"), std::string::npos) << o.err;
+}
+
+TEST_F(SweepPowerCurve, AnEarlierTableWithoutItsDirectoriesStillNamesItsPoints) {
+  // sweep.csv as sweeps wrote it before it had the directory column: the names come from the
+  // index and the values.
+  const Outcome first =
+      millsim("sweep " + quoted(small_mill) + " --vary charge.filling=0.2,0.3 -q --out v" +
+              tiny_run + tiny_speed);
+  ASSERT_EQ(first.status, 0) << first.err;
+  std::ofstream(work_ / "v" / "sweep.csv") << "point,charge.filling,status,power_kw\n"
+                                           << "0,0.2,ok,1\n"
+                                           << "1,0.3,ok,1\n";
+  const Outcome second = millsim("sweep " + quoted(small_mill) +
+                                 " --vary charge.filling=0.25 --out v" + tiny_run + tiny_speed);
+  ASSERT_EQ(second.status, 0) << second.err;
+  EXPECT_FALSE(fs::exists(work_ / "v" / "000_charge.filling=0.2"));
+  EXPECT_FALSE(fs::exists(work_ / "v" / "001_charge.filling=0.3"));
+  EXPECT_TRUE(fs::exists(work_ / "v" / "000_charge.filling=0.25" / "summary.json"));
 }
 
 TEST_F(SweepPowerCurve, AListValueMayHoldCommasInsideAnArray) {

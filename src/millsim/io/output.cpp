@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
@@ -107,12 +109,17 @@ std::string spectrum_table(const MillResult& result) {
   return text;
 }
 
-/// One number of summary.json; `whole` numbers are written as JSON integers.
+/// One number of summary.json; `whole` numbers are written as JSON integers. One that is not
+/// `present` is a number this run has none of (a toe angle of a centrifuging charge, say): left
+/// out of summary.json, listed only where every run's columns must line up (sweep.csv).
 struct SummaryNumber {
   std::string name;  ///< dotted for nested objects
   double value = 0.0;
   bool whole = false;
+  bool present = true;
 };
+
+constexpr double absent = std::numeric_limits<double>::quiet_NaN();
 
 /// summary.json's "empirical" object: the three models' powers, the inputs they were given and
 /// the intermediate quantities of each (docs/empirical_power.md).
@@ -120,7 +127,8 @@ void append_empirical_numbers(std::vector<SummaryNumber>& numbers, const Empiric
   const EmpiricalPowerInputs& in = p.inputs;
   const MorrellPower& m = p.morrell;
   // Bond's power only where its equation gives one (BondPower::applies).
-  if (p.bond.applies) numbers.push_back({"empirical.bond_kw", p.bond.power_kw});
+  numbers.push_back(
+      {"empirical.bond_kw", p.bond.applies ? p.bond.power_kw : absent, false, p.bond.applies});
   const std::vector<SummaryNumber> empirical{
       {"empirical.hogg_fuerstenau_kw", p.hogg_fuerstenau.power_kw},
       {"empirical.morrell_net_kw", m.net_kw},
@@ -185,20 +193,19 @@ std::vector<SummaryNumber> summary_numbers(const MillResult& r) {
       {"dimension", count(c.dimension), true},
   };
   // Only where the charge has a toe and a shoulder (not when it lines the whole shell).
-  if (r.charge_profile) {
-    if (const auto ends = r.charge_profile->toe_and_shoulder()) {
-      numbers.push_back({"charge_toe_angle_rad", ends->toe});
-      numbers.push_back({"charge_shoulder_angle_rad", ends->shoulder});
-    }
-  }
+  const auto ends = r.charge_profile ? r.charge_profile->toe_and_shoulder() : std::nullopt;
+  numbers.push_back({"charge_toe_angle_rad", ends ? ends->toe : absent, false, ends.has_value()});
+  numbers.push_back(
+      {"charge_shoulder_angle_rad", ends ? ends->shoulder : absent, false, ends.has_value()});
   append_empirical_numbers(numbers, empirical_power(plan));
-  if (c.reference) {
-    numbers.push_back({"reference.measured_power_kw", c.reference->measured_kw});
-    numbers.push_back({"reference.tolerance", c.reference->tolerance});
-    if (c.reference->paper_kw) {
-      numbers.push_back({"reference.paper_power_kw", *c.reference->paper_kw});
-    }
-  }
+  const bool reference = c.reference.has_value();
+  numbers.push_back({"reference.measured_power_kw", reference ? c.reference->measured_kw : absent,
+                     false, reference});
+  numbers.push_back(
+      {"reference.tolerance", reference ? c.reference->tolerance : absent, false, reference});
+  const bool paper = reference && c.reference->paper_kw.has_value();
+  numbers.push_back(
+      {"reference.paper_power_kw", paper ? *c.reference->paper_kw : absent, false, paper});
   return numbers;
 }
 
@@ -307,8 +314,16 @@ template void SnapshotWriter::write(const World<3>&);
 
 std::vector<std::pair<std::string, double>> summary_scalars(const MillResult& result) {
   std::vector<std::pair<std::string, double>> scalars;
-  for (const SummaryNumber& n : summary_numbers(result)) scalars.emplace_back(n.name, n.value);
+  for (const SummaryNumber& n : summary_numbers(result)) {
+    if (n.present) scalars.emplace_back(n.name, n.value);
+  }
   return scalars;
+}
+
+std::vector<std::pair<std::string, double>> summary_columns(const MillResult& result) {
+  std::vector<std::pair<std::string, double>> columns;
+  for (const SummaryNumber& n : summary_numbers(result)) columns.emplace_back(n.name, n.value);
+  return columns;
 }
 
 std::string summary_json(const MillResult& r) {
@@ -330,6 +345,7 @@ std::string summary_json(const MillResult& r) {
   // JSON has no infinity or NaN: a run whose figures are not finite has diverged, and is
   // reported as failed rather than written.
   for (const SummaryNumber& n : summary_numbers(r)) {
+    if (!n.present) continue;
     if (!std::isfinite(n.value)) {
       throw std::runtime_error(
           fmt::format("the run diverged: {} is {} (no results written)", n.name, n.value));

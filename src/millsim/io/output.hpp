@@ -60,6 +60,10 @@ std::string summary_json(const MillResult& result);
 /// this list, so the two always agree.
 std::vector<std::pair<std::string, double>> summary_scalars(const MillResult& result);
 
+/// summary_scalars with the numbers this run has none of too (NaN), so that runs of the same
+/// kind of mill list the same names in the same order: sweep.csv's columns.
+std::vector<std::pair<std::string, double>> summary_columns(const MillResult& result);
+
 /// The one-line summary printed at the end of a run: the DEM power, with the empirical models'
 /// (measure/empirical_power.hpp) beside it.
 std::string summary_line(const MillResult& result);

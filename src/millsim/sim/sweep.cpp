@@ -354,7 +354,9 @@ std::string sweep_csv(const std::vector<SweepAxis>& axes, const std::vector<Swee
     cells.push_back(warnings);
     for (const std::string& name : names) {
       const auto found = values.find(name);
-      cells.push_back(found == values.end() ? std::string() : fmt::format("{}", found->second));
+      // A number the point has none of (NaN) leaves its cell empty, as a failed point does.
+      const bool has = found != values.end() && !std::isnan(found->second);
+      cells.push_back(has ? fmt::format("{}", found->second) : std::string());
     }
     text += csv_line(cells);
   }
