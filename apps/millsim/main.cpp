@@ -41,6 +41,7 @@ namespace {
 using millsim::MillConfig;
 using millsim::MillPlan;
 using millsim::MillResult;
+using millsim_app::check_output_directory;
 using millsim_app::prepare_output_directory;
 using millsim_app::refuse_a_file_as_directory;
 using millsim_app::Snapshots;
@@ -550,6 +551,9 @@ void run_sweep(const std::vector<MillPlan>& plans, const std::vector<millsim::Sw
   omp_set_max_active_levels(levels);
 }
 
+/// The largest earlier sweep.csv read for the names of its points.
+constexpr std::uintmax_t most_sweep_table_bytes = 64U << 20U;
+
 /// The whole text of a file (empty if it cannot be read).
 std::string read_text(const std::filesystem::path& path) {
   std::ifstream file(path, std::ios::binary);
@@ -565,6 +569,8 @@ std::vector<std::string> earlier_point_directories(const std::filesystem::path& 
   const std::filesystem::path path = root / "sweep.csv";
   std::error_code error;
   if (!std::filesystem::is_regular_file(std::filesystem::symlink_status(path, error))) return {};
+  // A sweep's table is a few MB at most (10 000 points); anything far larger is not one.
+  if (std::filesystem::file_size(path, error) > most_sweep_table_bytes || error) return {};
   const std::vector<std::vector<std::string>> rows = millsim::csv_rows(read_text(path));
   if (rows.size() < 2 || rows[0].empty() || rows[0][0] != "point") return {};
   const std::vector<std::string>& header = rows[0];
@@ -573,7 +579,11 @@ std::vector<std::string> earlier_point_directories(const std::filesystem::path& 
   const auto status = std::find(header.begin(), header.end(), "status");
   if (status == header.end()) return {};
   const auto end_key = static_cast<std::size_t>(status - header.begin());
-  if (end_key < first_key) return {};
+  // A sweep varies at least one key, each a config key.
+  if (end_key <= first_key) return {};
+  for (std::size_t k = first_key; k < end_key; ++k) {
+    if (!millsim::is_config_key(header[k])) return {};
+  }
   std::vector<millsim::SweepAxis> axes;
   for (std::size_t k = first_key; k < end_key; ++k) axes.push_back({header[k], {}});
   const std::size_t count = rows.size() - 1;
@@ -647,29 +657,51 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
     rows[i].directory = std::filesystem::path(plans[i].config.output_directory).filename().string();
     current.insert(rows[i].directory);
   }
-  std::set<std::string, std::less<>> removed;
+  // Everything the clearing below would refuse is refused first, so that a refusal clears
+  // nothing: the earlier points', this sweep's points' and the table's names.
+  std::vector<std::string> stale;
   for (const std::string& name : earlier_point_directories(root)) {
-    if (current.contains(name) || removed.contains(name)) continue;
+    if (current.contains(name) || std::find(stale.begin(), stale.end(), name) != stale.end()) {
+      continue;
+    }
+    stale.push_back(name);
+    check_output_directory(root / name,
+                           fmt::format("{}, a point of the earlier sweep", root_location),
+                           mill_result_names, Snapshots::removed);
+  }
+  std::vector<std::string> existing;  // this sweep's point directories that are there already
+  for (const std::string& name : current) {
+    std::error_code error;
+    const std::filesystem::file_status state = std::filesystem::symlink_status(root / name, error);
+    if (std::filesystem::is_symlink(state)) {
+      throw millsim::InputError(fmt::format(
+          "{}: sweep point {} is a link; allowed: a directory, or no file of that name (a "
+          "point's results are written in its own directory under --out)",
+          root_location, (root / name).string()));
+    }
+    if (!std::filesystem::is_directory(state)) continue;  // a file there fails that point only
+    existing.push_back(name);
+    check_output_directory(root / name, root_location, mill_result_names, Snapshots::removed);
+  }
+  check_output_directory(root, root_location, {"sweep.csv"});
+  for (const std::string& name : stale) {
     const std::string context = fmt::format("{}, a point of the earlier sweep", root_location);
     warn(prepare_output_directory(root / name, context, mill_result_names, Snapshots::removed),
          context);
     std::error_code error;
     std::filesystem::remove(root / name, error);  // only when nothing else is left in it
-    removed.insert(name);
   }
-  for (const std::string& name : current) {
-    std::error_code error;
-    if (!std::filesystem::is_directory(std::filesystem::symlink_status(root / name, error))) {
-      continue;
-    }
+  for (const std::string& name : existing) {
     warn(
         prepare_output_directory(root / name, root_location, mill_result_names, Snapshots::removed),
         fmt::format("sweep point {}", name));
   }
-  warn(prepare_output_directory(root, root_location, {"sweep.csv"}));
-  if (!removed.empty() && !options.quiet) {
+  // The earlier table stays until the new one replaces it (a rename), listing what is left
+  // should the sweep be stopped before.
+  warn(prepare_output_directory(root, root_location, {}));
+  if (!stale.empty() && !options.quiet) {
     fmt::print(stderr, "millsim: removed the results of {} {} of the earlier sweep in {}/\n",
-               removed.size(), removed.size() == 1 ? "point" : "points", shown);
+               stale.size(), stale.size() == 1 ? "point" : "points", shown);
   }
   // The table from the start, every point pending, so that a sweep stopped early still says
   // which directories are its own and which points finished.

@@ -88,19 +88,56 @@ void make_and_check_writable(const fs::path& out, const std::string& location) {
   }
 }
 
-}  // namespace
-
-std::vector<std::string> prepare_output_directory(const fs::path& out, const std::string& location,
-                                                  std::initializer_list<const char*> results,
-                                                  Snapshots snapshots) {
-  refuse_a_file_as_directory(out, location);
-  make_and_check_writable(out, location);
+/// The names an earlier run's results may have in `out`: each result, its .partial, and
+/// snapshots/ unless untouched.
+std::vector<std::string> result_names(std::initializer_list<const char*> results,
+                                      Snapshots snapshots) {
   std::vector<std::string> names;
   for (const char* name : results) {
     names.emplace_back(name);
     names.push_back(std::string(name) + ".partial");
   }
   if (snapshots != Snapshots::untouched) names.emplace_back("snapshots");
+  return names;
+}
+
+/// Refuses a directory of the user's (not empty, or unreadable) under a result's name, other
+/// than snapshots/ (ours): the run would fail to write the result there at its end.
+void refuse_a_taken_name(const fs::path& out, const std::string& location,
+                         const std::string& name) {
+  std::error_code error;
+  if (name == "snapshots" ||
+      fs::symlink_status(out / name, error).type() != fs::file_type::directory) {
+    return;
+  }
+  const bool empty = fs::is_empty(out / name, error);
+  if (!error && empty) return;
+  throw millsim::InputError(fmt::format(
+      "{}: output.directory: \"{}\" holds a directory {} where the run writes a result ({}); "
+      "allowed: an output directory where no result's name is taken (remove or rename {}, or "
+      "choose another directory)",
+      location, out.string(), name, error ? error.message() : "not empty", (out / name).string()));
+}
+
+}  // namespace
+
+void check_output_directory(const fs::path& out, const std::string& location,
+                            std::initializer_list<const char*> results, Snapshots snapshots) {
+  refuse_a_file_as_directory(out, location);
+  std::error_code error;
+  if (fs::symlink_status(out, error).type() == fs::file_type::not_found) return;
+  make_and_check_writable(out, location);
+  for (const std::string& name : result_names(results, snapshots)) {
+    refuse_a_taken_name(out, location, name);
+  }
+}
+
+std::vector<std::string> prepare_output_directory(const fs::path& out, const std::string& location,
+                                                  std::initializer_list<const char*> results,
+                                                  Snapshots snapshots) {
+  refuse_a_file_as_directory(out, location);
+  make_and_check_writable(out, location);
+  const std::vector<std::string> names = result_names(results, snapshots);
   const auto refuse_clearing = [&](const std::string& why) {
     return millsim::InputError(
         fmt::format("{}: output.directory: cannot clear earlier results from \"{}\" ({}); "
@@ -111,18 +148,11 @@ std::vector<std::string> prepare_output_directory(const fs::path& out, const std
   // user's: the run would fail to write the result there at its end. Refused before anything
   // moves. An empty one holds nothing to lose and is removed now (it may be one that cannot be
   // moved: renaming a directory needs write access to it, removing it does not).
+  for (const std::string& name : names) refuse_a_taken_name(out, location, name);
   for (const std::string& name : names) {
     std::error_code error;
     if (fs::symlink_status(out / name, error).type() != fs::file_type::directory) continue;
     const bool empty = fs::is_empty(out / name, error);
-    if ((error || !empty) && name != "snapshots") {
-      throw millsim::InputError(fmt::format(
-          "{}: output.directory: \"{}\" holds a directory {} where the run writes a result "
-          "({}); allowed: an output directory where no result's name is taken (remove or "
-          "rename {}, or choose another directory)",
-          location, out.string(), name, error ? error.message() : "not empty",
-          (out / name).string()));
-    }
     if (!error && empty && !fs::remove(out / name, error) && error) {
       throw refuse_clearing(fmt::format("{}: {}", name, error.message()));
     }

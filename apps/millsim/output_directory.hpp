@@ -27,6 +27,14 @@ enum class Snapshots { untouched, removed, made };
 /// snapshots/ cannot be made, so that a refusal loses nothing), then removed. Returns warnings
 /// for the run to print (what could be moved aside but not removed). Throws InputError naming
 /// `location` (config line, --set or --out) if the directory cannot be used.
+/// The refusals prepare_output_directory would make, with nothing moved or removed: `out`
+/// exists as something else, cannot be written, or holds a directory of the user's under a
+/// result's name. Nothing to check if `out` does not exist yet. For a job that clears several
+/// directories (a sweep), so that a refusal comes before any is cleared.
+void check_output_directory(const std::filesystem::path& out, const std::string& location,
+                            std::initializer_list<const char*> results,
+                            Snapshots snapshots = Snapshots::untouched);
+
 std::vector<std::string> prepare_output_directory(const std::filesystem::path& out,
                                                   const std::string& location,
                                                   std::initializer_list<const char*> results,

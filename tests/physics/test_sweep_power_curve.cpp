@@ -213,6 +213,49 @@ TEST_F(SweepPowerCurve, AnEarlierTableNamesNothingButItsOwnPointDirectories) {
   EXPECT_EQ(o.err.find("removed the results"), std::string::npos) << o.err;
 }
 
+TEST_F(SweepPowerCurve, ARefusalWhileClearingTheEarlierSweepClearsNothing) {
+  const Outcome first =
+      millsim("sweep " + quoted(small_mill) + " --vary charge.filling=0.2,0.3 -q --out w" +
+              tiny_run + tiny_speed);
+  ASSERT_EQ(first.status, 0) << first.err;
+  const std::string table = read_all(work_ / "w" / "sweep.csv");
+  const std::string summary = read_all(work_ / "w" / "000_charge.filling=0.2" / "summary.json");
+  // The second earlier point holds a directory of the user's under a result's name.
+  fs::remove(work_ / "w" / "001_charge.filling=0.3" / "power.csv");
+  fs::create_directories(work_ / "w" / "001_charge.filling=0.3" / "power.csv" / "mine");
+  const Outcome second = millsim("sweep " + quoted(small_mill) +
+                                 " --vary charge.filling=0.25 -q --out w" + tiny_run + tiny_speed);
+  EXPECT_EQ(second.status, 2) << second.err;
+  EXPECT_NE(second.err.find("a point of the earlier sweep: output.directory: "
+                            "\"w/001_charge.filling=0.3\" holds a directory power.csv"),
+            std::string::npos)
+      << second.err;
+  EXPECT_EQ(read_all(work_ / "w" / "sweep.csv"), table);
+  EXPECT_EQ(read_all(work_ / "w" / "000_charge.filling=0.2" / "summary.json"), summary);
+  EXPECT_FALSE(fs::exists(work_ / "w" / "000_charge.filling=0.25"));
+  // A point's own directory that is a link is refused too, before anything is cleared.
+  fs::remove_all(work_ / "w" / "001_charge.filling=0.3" / "power.csv");
+  fs::create_directories(work_ / "elsewhere");
+  fs::create_directory_symlink(work_ / "elsewhere", work_ / "w" / "000_charge.filling=0.25");
+  const Outcome linked = millsim("sweep " + quoted(small_mill) +
+                                 " --vary charge.filling=0.25 -q --out w" + tiny_run + tiny_speed);
+  EXPECT_EQ(linked.status, 2) << linked.err;
+  EXPECT_NE(linked.err.find("sweep point w/000_charge.filling=0.25 is a link"), std::string::npos)
+      << linked.err;
+  EXPECT_EQ(read_all(work_ / "w" / "000_charge.filling=0.2" / "summary.json"), summary);
+}
+
+TEST_F(SweepPowerCurve, AnEarlierTableWithoutVariedKeysNamesNothing) {
+  // A table no sweep writes (a sweep varies a key): numbered folders of the user's stay.
+  fs::create_directories(work_ / "x" / "000");
+  std::ofstream(work_ / "x" / "000" / "summary.json") << "mine\n";
+  std::ofstream(work_ / "x" / "sweep.csv") << "point,status\n0,ok\n";
+  const Outcome o = millsim("sweep " + quoted(small_mill) +
+                            " --vary charge.filling=0.25 -q --out x" + tiny_run + tiny_speed);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_EQ(read_all(work_ / "x" / "000" / "summary.json"), "mine\n");
+}
+
 TEST_F(SweepPowerCurve, AnEarlierTableWithoutItsDirectoriesStillNamesItsPoints) {
   // sweep.csv as sweeps wrote it before it had the directory column: the names come from the
   // index and the values.

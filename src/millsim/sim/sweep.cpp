@@ -42,14 +42,6 @@ std::string_view trim(std::string_view text) {
   return text.substr(first, last - first + 1);
 }
 
-bool valid_key(std::string_view key) {
-  if (key.empty() || key.front() == '.' || key.back() == '.') return false;
-  if (key.find("..") != std::string_view::npos) return false;
-  return std::all_of(key.begin(), key.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-' || c == '.';
-  });
-}
-
 std::optional<double> read_number(std::string_view text) {
   if (!text.empty() && text.front() == '+') text.remove_prefix(1);
   double value = 0.0;
@@ -178,6 +170,14 @@ std::uint32_t stable_hash(std::string_view text) {
 
 }  // namespace
 
+bool is_config_key(std::string_view key) {
+  if (key.empty() || key.front() == '.' || key.back() == '.') return false;
+  if (key.find("..") != std::string_view::npos) return false;
+  return std::all_of(key.begin(), key.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-' || c == '.';
+  });
+}
+
 std::string csv_line(const std::vector<std::string>& cells) {
   std::string line;
   for (std::size_t k = 0; k < cells.size(); ++k) {
@@ -197,7 +197,7 @@ SweepAxis parse_vary(std::string_view argument) {
   }
   SweepAxis axis;
   axis.key = std::string(trim(argument.substr(0, equals)));
-  if (!valid_key(axis.key)) {
+  if (!is_config_key(axis.key)) {
     throw InputError(fmt::format(
         "{}: \"{}\" is not a key; allowed: names of letters, digits, _ and - joined by dots, "
         "e.g. mill.speed",

@@ -70,6 +70,10 @@ struct SweepRow {
   std::vector<std::string> warnings;
 };
 
+/// Whether `key` has the shape of a dotted config key: names of letters, digits, _ and -
+/// joined by dots (mill.speed), as --vary takes them.
+bool is_config_key(std::string_view key);
+
 /// One CSV line of `cells`, ended by a line break; a cell with a comma, quote or line break is
 /// quoted (RFC 4180).
 std::string csv_line(const std::vector<std::string>& cells);
