@@ -6,9 +6,11 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -42,6 +44,8 @@ using millsim::MillConfig;
 using millsim::MillPlan;
 using millsim::MillResult;
 using millsim_app::check_output_directory;
+using millsim_app::EarlierResults;
+using millsim_app::move_results_aside;
 using millsim_app::prepare_output_directory;
 using millsim_app::refuse_a_file_as_directory;
 using millsim_app::Snapshots;
@@ -569,8 +573,21 @@ std::vector<std::string> earlier_point_directories(const std::filesystem::path& 
   const std::filesystem::path path = root / "sweep.csv";
   std::error_code error;
   if (!std::filesystem::is_regular_file(std::filesystem::symlink_status(path, error))) return {};
+  const auto unread = [&](const std::string& why) {
+    warn(
+        {fmt::format("{} is not read for the points of an earlier sweep ({}): their results, if "
+                     "any, stay beside this sweep's",
+                     path.string(), why)});
+    return std::vector<std::string>{};
+  };
   // A sweep's table is a few MB at most (10 000 points); anything far larger is not one.
-  if (std::filesystem::file_size(path, error) > most_sweep_table_bytes || error) return {};
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (error) return unread(error.message());
+  if (size > most_sweep_table_bytes) {
+    return unread(fmt::format("{} bytes, more than a sweep's table", size));
+  }
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return unread(std::strerror(errno));
   const std::vector<std::vector<std::string>> rows = millsim::csv_rows(read_text(path));
   if (rows.size() < 2 || rows[0].empty() || rows[0][0] != "point") return {};
   const std::vector<std::string>& header = rows[0];
@@ -684,29 +701,56 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
     check_output_directory(root / name, root_location, mill_result_names, Snapshots::removed);
   }
   check_output_directory(root, root_location, {"sweep.csv"});
+  for (const char* name : {"sweep.csv", "sweep.csv.partial"}) {
+    std::error_code error;
+    if (std::filesystem::is_directory(std::filesystem::symlink_status(root / name, error))) {
+      throw millsim::InputError(fmt::format(
+          "{}: \"{}\" is a directory, where the sweep writes its table; allowed: an output "
+          "directory without a directory of that name (remove or rename it)",
+          root_location, (root / name).string()));
+    }
+  }
+  // Every directory's earlier results are moved aside first, all put back if one cannot be,
+  // so that a refusal clears nothing; then the new table replaces the old (a rename), and only
+  // then is what was moved aside removed. A sweep stopped in between leaves the old table and
+  // the results aside, which the next run or sweep there removes.
+  std::vector<EarlierResults> aside;
+  const auto put_all_back = [&] {
+    for (auto back = aside.rbegin(); back != aside.rend(); ++back) {
+      (void)back->put_back("");
+    }
+  };
+  const std::string earlier_context =
+      fmt::format("{}, a point of the earlier sweep", root_location);
+  const std::filesystem::path table = root / "sweep.csv";
+  try {
+    for (const std::string& name : stale) {
+      aside.push_back(
+          move_results_aside(root / name, earlier_context, mill_result_names, Snapshots::removed));
+    }
+    for (const std::string& name : existing) {
+      aside.push_back(
+          move_results_aside(root / name, root_location, mill_result_names, Snapshots::removed));
+    }
+    aside.push_back(move_results_aside(root, root_location, {"sweep.csv.partial"}));
+    // The table from the start, every point pending, so that a sweep stopped early still says
+    // which directories are its own and which points finished.
+    millsim::write_sweep_csv(table, axes, rows);
+  } catch (...) {
+    put_all_back();
+    throw;
+  }
+  for (EarlierResults& results : aside) {
+    warn(results.remove(), results.location);
+  }
   for (const std::string& name : stale) {
-    const std::string context = fmt::format("{}, a point of the earlier sweep", root_location);
-    warn(prepare_output_directory(root / name, context, mill_result_names, Snapshots::removed),
-         context);
     std::error_code error;
     std::filesystem::remove(root / name, error);  // only when nothing else is left in it
   }
-  for (const std::string& name : existing) {
-    warn(
-        prepare_output_directory(root / name, root_location, mill_result_names, Snapshots::removed),
-        fmt::format("sweep point {}", name));
-  }
-  // The earlier table stays until the new one replaces it (a rename), listing what is left
-  // should the sweep be stopped before.
-  warn(prepare_output_directory(root, root_location, {}));
   if (!stale.empty() && !options.quiet) {
     fmt::print(stderr, "millsim: removed the results of {} {} of the earlier sweep in {}/\n",
                stale.size(), stale.size() == 1 ? "point" : "points", shown);
   }
-  // The table from the start, every point pending, so that a sweep stopped early still says
-  // which directories are its own and which points finished.
-  const std::filesystem::path table = root / "sweep.csv";
-  millsim::write_sweep_csv(table, axes, rows);
   run_sweep(plans, axes, rows, table, options.quiet, parallel);
 
   // The table on stdout first: a sweep.csv that cannot be written fails the command after the

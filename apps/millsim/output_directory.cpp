@@ -132,18 +132,14 @@ void check_output_directory(const fs::path& out, const std::string& location,
   }
 }
 
-std::vector<std::string> prepare_output_directory(const fs::path& out, const std::string& location,
-                                                  std::initializer_list<const char*> results,
-                                                  Snapshots snapshots) {
+EarlierResults move_results_aside(const fs::path& out, const std::string& location,
+                                  std::initializer_list<const char*> results, Snapshots snapshots) {
   refuse_a_file_as_directory(out, location);
   make_and_check_writable(out, location);
-  const std::vector<std::string> names = result_names(results, snapshots);
-  const auto refuse_clearing = [&](const std::string& why) {
-    return millsim::InputError(
-        fmt::format("{}: output.directory: cannot clear earlier results from \"{}\" ({}); "
-                    "allowed: a directory whose earlier results can be removed",
-                    location, out.string(), why));
-  };
+  std::vector<std::string> names = result_names(results, snapshots);
+  EarlierResults earlier;
+  earlier.out = out;
+  earlier.location = location;
   // A directory under a result's name (not snapshots/, which is ours) that is not empty is the
   // user's: the run would fail to write the result there at its end. Refused before anything
   // moves. An empty one holds nothing to lose and is removed now (it may be one that cannot be
@@ -154,51 +150,79 @@ std::vector<std::string> prepare_output_directory(const fs::path& out, const std
     if (fs::symlink_status(out / name, error).type() != fs::file_type::directory) continue;
     const bool empty = fs::is_empty(out / name, error);
     if (!error && empty && !fs::remove(out / name, error) && error) {
-      throw refuse_clearing(fmt::format("{}: {}", name, error.message()));
+      throw earlier.refusal(fmt::format("{}: {}", name, error.message()));
     }
   }
-
+  // What an earlier clearing that was stopped left moved aside goes too.
+  std::error_code listing;
+  for (const auto& entry : fs::directory_iterator(out, listing)) {
+    const std::string name = entry.path().filename().string();
+    if (name.starts_with(aside_prefix)) names.push_back(name);
+  }
   // The earlier results are renamed into a directory of their own in `out`, so that if one
-  // cannot be (or a new snapshots/ cannot be made), those moved are put back and the refusal
-  // loses nothing; then that directory is removed.
-  std::string aside = (out / ".millsim-earlier-results-XXXXXX").string();
-  if (::mkdtemp(aside.data()) == nullptr) throw refuse_clearing(std::strerror(errno));
-  std::vector<std::string> moved;
-  const auto put_back = [&](const std::string& why) {
-    std::vector<std::string> stuck;
-    for (auto back = moved.rbegin(); back != moved.rend(); ++back) {
-      std::error_code error;
-      fs::rename(fs::path(aside) / *back, out / *back, error);
-      if (error) stuck.push_back(*back);
-    }
-    std::error_code ignored;
-    fs::remove(aside, ignored);  // only if it is empty again
-    if (stuck.empty()) return refuse_clearing(why);
-    return refuse_clearing(fmt::format("{}; and {} could not be put back: they are in {}/", why,
-                                       fmt::join(stuck, ", "), aside));
-  };
+  // cannot be, those moved are put back and the refusal loses nothing.
+  std::string aside = (out / (std::string(aside_prefix) + "XXXXXX")).string();
+  if (::mkdtemp(aside.data()) == nullptr) throw earlier.refusal(std::strerror(errno));
+  earlier.aside = aside;
   for (const std::string& name : names) {
     std::error_code error;
     if (fs::symlink_status(out / name, error).type() == fs::file_type::not_found) continue;
-    fs::rename(out / name, fs::path(aside) / name, error);
-    if (error) throw put_back(fmt::format("{}: {}", name, error.message()));
-    moved.push_back(name);
+    fs::rename(out / name, earlier.aside / name, error);
+    if (error) throw earlier.put_back(fmt::format("{}: {}", name, error.message()));
+    earlier.moved.push_back(name);
   }
-  if (snapshots == Snapshots::made) {
+  return earlier;
+}
+
+millsim::InputError EarlierResults::refusal(const std::string& why) const {
+  return millsim::InputError(
+      fmt::format("{}: output.directory: cannot clear earlier results from \"{}\" ({}); "
+                  "allowed: a directory whose earlier results can be removed",
+                  location, out.string(), why));
+}
+
+millsim::InputError EarlierResults::put_back(const std::string& why) {
+  std::vector<std::string> stuck;
+  for (auto back = moved.rbegin(); back != moved.rend(); ++back) {
     std::error_code error;
-    fs::create_directory(out / "snapshots", error);
-    if (error) throw put_back(fmt::format("snapshots: cannot make it: {}", error.message()));
+    fs::rename(aside / *back, out / *back, error);
+    if (error) stuck.push_back(*back);
   }
+  moved.clear();
+  std::error_code ignored;
+  if (!aside.empty()) fs::remove(aside, ignored);  // only if it is empty again
+  if (stuck.empty()) return refusal(why);
+  return refusal(fmt::format("{}; and {} could not be put back: they are in {}/", why,
+                             fmt::join(stuck, ", "), aside.string()));
+}
+
+std::vector<std::string> EarlierResults::remove() {
   std::vector<std::string> warnings;
+  if (aside.empty()) return warnings;
   std::error_code error;
   fs::remove_all(aside, error);
   if (error) {
     warnings.push_back(fmt::format(
         "an earlier run's results were moved aside to {}/ but could not all be removed ({}): "
         "remove that directory yourself",
-        aside, error.message()));
+        aside.string(), error.message()));
   }
+  moved.clear();
   return warnings;
+}
+
+std::vector<std::string> prepare_output_directory(const fs::path& out, const std::string& location,
+                                                  std::initializer_list<const char*> results,
+                                                  Snapshots snapshots) {
+  EarlierResults earlier = move_results_aside(out, location, results, snapshots);
+  if (snapshots == Snapshots::made) {
+    std::error_code error;
+    fs::create_directory(out / "snapshots", error);
+    if (error) {
+      throw earlier.put_back(fmt::format("snapshots: cannot make it: {}", error.message()));
+    }
+  }
+  return earlier.remove();
 }
 
 }  // namespace millsim_app

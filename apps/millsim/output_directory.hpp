@@ -7,7 +7,10 @@
 #include <filesystem>
 #include <initializer_list>
 #include <string>
+#include <string_view>
 #include <vector>
+
+#include "millsim/core/error.hpp"
 
 namespace millsim_app {
 
@@ -34,6 +37,35 @@ enum class Snapshots { untouched, removed, made };
 void check_output_directory(const std::filesystem::path& out, const std::string& location,
                             std::initializer_list<const char*> results,
                             Snapshots snapshots = Snapshots::untouched);
+
+/// The name of the directory in which an output directory's earlier results are moved aside
+/// (followed by 6 random characters) before they are removed.
+inline constexpr std::string_view aside_prefix = ".millsim-earlier-results-";
+
+/// An earlier run's results in `out`, moved aside into `aside` (move_results_aside), to be
+/// removed once the new run may start, or put back if it may not.
+struct EarlierResults {
+  std::filesystem::path out;
+  std::filesystem::path aside;  // empty: nothing made
+  std::string location;
+  std::vector<std::string> moved;
+
+  /// Puts what was moved back where it was; returns the refusal to throw, saying `why`, and
+  /// where anything is that could not be put back.
+  millsim::InputError put_back(const std::string& why);
+  /// Removes what was moved aside; warnings for what could not be removed.
+  std::vector<std::string> remove();
+  /// The refusal to clear `out`, saying `why`.
+  millsim::InputError refusal(const std::string& why) const;
+};
+
+/// The first half of prepare_output_directory: `out` made and checked, its results (and what
+/// an earlier clearing that was stopped left aside) moved into a directory of their own; a
+/// refusal (InputError) puts back what it moved. For a job that clears several directories
+/// and must refuse before it removes any (a sweep).
+EarlierResults move_results_aside(const std::filesystem::path& out, const std::string& location,
+                                  std::initializer_list<const char*> results,
+                                  Snapshots snapshots = Snapshots::untouched);
 
 std::vector<std::string> prepare_output_directory(const std::filesystem::path& out,
                                                   const std::string& location,

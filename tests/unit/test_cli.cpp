@@ -490,8 +490,11 @@ TEST_F(Cli, ARunRemovesTheResultsAnEarlierRunLeftInItsDirectory) {
   EXPECT_EQ(read_all(work_ / "out" / "notes.txt"), "stale\n");
 
   // A killed run's .partial file and snapshots go too (this run writes no snapshots), and the
-  // directory they were moved aside to before removal is gone.
+  // directory they were moved aside to before removal is gone; so does one that a run (or
+  // sweep) stopped while it cleared had left.
   std::ofstream(work_ / "out" / "impacts.csv.partial") << "half\n";
+  fs::create_directories(work_ / "out" / ".millsim-earlier-results-a1B2c3" / "snapshots");
+  std::ofstream(work_ / "out" / ".millsim-earlier-results-a1B2c3" / "summary.json") << "old\n";
   fs::create_directories(work_ / "out" / "snapshots" / "deep");
   std::ofstream(work_ / "out" / "snapshots" / "deep" / "snapshot_000000.csv") << "stale\n";
   ASSERT_EQ(millsim(std::string("run mill.toml -o out -q ") + tiny_run).status, 0);
