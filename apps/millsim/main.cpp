@@ -6,16 +6,19 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <initializer_list>
 #include <iterator>
+#include <mutex>
 #include <new>
 #include <optional>
 #include <set>
@@ -23,6 +26,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <thread>
 #include <variant>
 #include <vector>
 
@@ -124,8 +128,9 @@ std::string output_location(const Config& config, const JobOptions& options) {
 /// Prints each warning on stderr as "millsim: warning: [CONTEXT: ]TEXT" (sweep points print
 /// from several threads).
 void warn(const std::vector<std::string>& warnings, std::string_view context = {}) {
+  static std::mutex printing;
   for (const std::string& text : warnings) {
-#pragma omp critical(millsim_warning)
+    const std::lock_guard lock(printing);
     fmt::print(stderr, "millsim: warning: {}{}{}\n", context, context.empty() ? "" : ": ", text);
   }
 }
@@ -390,6 +395,10 @@ int validate_command(const std::string& directory, const JobOptions& options) {
     }
     config.output_directory = (root / path.stem()).string();
     refuse_a_file_as_directory(config.output_directory, root_location);
+    // What clearing the case's earlier results would refuse is refused before any case runs,
+    // as a sweep refuses it for its points.
+    check_output_directory(config.output_directory, root_location, mill_result_names,
+                           config.snapshot_interval > 0.0 ? Snapshots::made : Snapshots::removed);
     MillPlan plan = millsim::plan_mill(config);
     // The charge placed as run places it (as info does), so that a filling the mill cannot
     // hold refuses the validation before any case runs.
@@ -401,17 +410,23 @@ int validate_command(const std::string& directory, const JobOptions& options) {
   }
   struct Row {
     std::string name;
-    double measured, predicted, tolerance;
+    double measured = 0.0, predicted = 0.0, tolerance = 0.0;
     std::optional<double> paper;
   };
-  std::vector<Row> rows;
+  std::vector<Row> rows(plans.size());
   // The table of an earlier validation goes once the first case's directory is ready (a case
   // refused there leaves it), before any case runs: a validation that fails half-way leaves no
   // table from another.
   bool earlier_table_removed = false;
-  for (const MillPlan& plan : plans) {
+  std::mutex starting;
+  // The cases as a sweep's points: as many at a time as there are threads (the small mills
+  // gain little from a second thread), a progress line only when they run one at a time.
+  const millsim::ThreadShare share = millsim::share_threads(omp_get_max_threads(), plans.size());
+  millsim::run_shared(plans.size(), share, [&](std::size_t i) {
+    const MillPlan& plan = plans[i];
     const MillConfig& config = plan.config;
     const auto started = [&] {
+      const std::lock_guard lock(starting);
       if (!earlier_table_removed) {
         for (const auto& stale :
              {table_path, std::filesystem::path(table_path.string() + ".partial")}) {
@@ -422,12 +437,13 @@ int validate_command(const std::string& directory, const JobOptions& options) {
       }
       if (!options.quiet) fmt::print(stderr, "running {} ...\n", config.source);
     };
+    const bool progress = !options.quiet && share.at_a_time <= 1;
     const MillResult result = config.dimension == 2
-                                  ? run_job<2>(plan, root_location, !options.quiet, started)
-                                  : run_job<3>(plan, root_location, !options.quiet, started);
-    rows.push_back({config.reference->case_name, config.reference->measured_kw, result.power_kw,
-                    config.reference->tolerance, config.reference->paper_kw});
-  }
+                                  ? run_job<2>(plan, root_location, progress, started)
+                                  : run_job<3>(plan, root_location, progress, started);
+    rows[i] = {config.reference->case_name, config.reference->measured_kw, result.power_kw,
+               config.reference->tolerance, config.reference->paper_kw};
+  });
   fmt::print("{:<8} {:>12} {:>12} {:>12} {:>9} {:>10}  {}\n", "case", "measured_kW", "paper_kW",
              "millsim_kW", "error_%", "paper_err%", "within");
   int failures = 0;
@@ -495,16 +511,17 @@ std::vector<MillPlan> plan_sweep(const JobOptions& options,
 /// Runs every planned point, filling in its row of `rows` (made pending), and rewrites
 /// sweep.csv at `table` as points finish (after each, unless writing it takes more than a
 /// twentieth of the time between: a sweep of many quick points), not after the last: the
-/// caller writes the whole table. With at least as many points as threads the points run in
-/// parallel, one thread each (nesting is off, so the World's own parallel loops run serially)
-/// and without progress lines; otherwise one after another with every thread. The results are
-/// the same either way. A point that fails is reported in its row.
+/// caller writes the whole table. The points run `share.at_a_time` at a time, each on
+/// `share.threads_each` threads, with progress lines only when they run one at a time. The
+/// results are the same either way (a run's results do not depend on its threads). A point
+/// that fails is reported in its row.
 void run_sweep(const std::vector<MillPlan>& plans, const std::vector<millsim::SweepAxis>& axes,
                std::vector<millsim::SweepRow>& rows, const std::filesystem::path& table, bool quiet,
-               bool parallel) {
+               const millsim::ThreadShare& share) {
   using Clock = std::chrono::steady_clock;
   auto last_written = Clock::now();
   Clock::duration writing{};  // how long the last rewrite took
+  std::mutex report;          // the rows, the table and the lines on stderr
   const auto run_point = [&](std::size_t i, bool show_progress) {
     millsim::SweepRow row = rows[i];
     const MillPlan& plan = plans[i];
@@ -522,11 +539,11 @@ void run_sweep(const std::vector<MillPlan>& plans, const std::vector<millsim::Sw
     } catch (const std::exception& error) {
       row.status = fmt::format("failed: {}", error.what());
     }
-#pragma omp critical(millsim_sweep_report)
     {
+      const std::lock_guard lock(report);
       rows[i] = std::move(row);
-      // Nothing may leave a parallel region: a table or a line that cannot be written here is
-      // left for the final table, written after the region, to report.
+      // Nothing may leave a point's thread: a table or a line that cannot be written here is
+      // left for the final table, written after the points, to report.
       try {
         const auto now = Clock::now();
         if (now - last_written >= 20 * writing) {
@@ -543,16 +560,8 @@ void run_sweep(const std::vector<MillPlan>& plans, const std::vector<millsim::Sw
       }
     }
   };
-  if (!parallel) {
-    for (std::size_t i = 0; i < rows.size(); ++i) run_point(i, !quiet);
-    return;
-  }
-  const int levels = omp_get_max_active_levels();
-  omp_set_max_active_levels(1);
-  const auto count = static_cast<std::ptrdiff_t>(rows.size());
-#pragma omp parallel for schedule(dynamic, 1)
-  for (std::ptrdiff_t i = 0; i < count; ++i) run_point(static_cast<std::size_t>(i), false);
-  omp_set_max_active_levels(levels);
+  millsim::run_shared(rows.size(), share,
+                      [&](std::size_t i) { run_point(i, !quiet && share.at_a_time <= 1); });
 }
 
 /// The largest earlier sweep.csv read for the names of its points.
@@ -650,13 +659,12 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
         root.string()));
   }
   const std::vector<MillPlan> plans = plan_sweep(options, axes, points, root);
-  const int threads = omp_get_max_threads();
-  const bool parallel = threads > 1 && points.size() >= static_cast<std::size_t>(threads);
+  const millsim::ThreadShare share = millsim::share_threads(omp_get_max_threads(), points.size());
   const std::string shown = (root / "").parent_path().string();  // without a trailing '/'
   if (!options.quiet) {
     fmt::print("millsim: sweeping {} {} of {} into {}/ ({})\n", points.size(),
                points.size() == 1 ? "point" : "points", plans.front().config.source, shown,
-               parallel ? fmt::format("{} at a time", threads) : std::string("one at a time"));
+               millsim::describe(share));
     std::fflush(stdout);
   }
   // An earlier sweep into the same directory (its sweep.csv): its points that this sweep does
@@ -751,7 +759,7 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
     fmt::print(stderr, "millsim: removed the results of {} {} of the earlier sweep in {}/\n",
                stale.size(), stale.size() == 1 ? "point" : "points", shown);
   }
-  run_sweep(plans, axes, rows, table, options.quiet, parallel);
+  run_sweep(plans, axes, rows, table, options.quiet, share);
 
   // The table on stdout first: a sweep.csv that cannot be written fails the command after the
   // results are shown.

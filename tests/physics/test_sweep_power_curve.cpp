@@ -112,19 +112,28 @@ TEST_F(SweepPowerCurve, ResultsDoNotDependOnTheThreadsAndEveryPointHasItsDirecto
                             " --vary mill.speed=1.5,2 --vary charge.filling=0.2,0.3 -q" + tiny_run;
   const Outcome serial = millsim(sweep + " -j 1 --out one");
   const Outcome parallel = millsim(sweep + " -j 2 --out two");
+  // Fewer points than threads: the points together, the threads shared among them (the
+  // opening line says how; -q leaves it out).
+  std::string shared = sweep + " -j 8 --out eight";
+  shared.erase(shared.find(" -q "), 3);
+  const Outcome nested = millsim(shared);
   ASSERT_EQ(serial.status, 0) << serial.err;
   ASSERT_EQ(parallel.status, 0) << parallel.err;
+  ASSERT_EQ(nested.status, 0) << nested.err;
+  EXPECT_NE(nested.out.find("(4 at a time, 2 threads each)"), std::string::npos) << nested.out;
   const auto one = read_csv(work_ / "one" / "sweep.csv");
-  const auto two = read_csv(work_ / "two" / "sweep.csv");
   ASSERT_EQ(one.size(), 4u);
-  ASSERT_EQ(two.size(), 4u);
-  for (std::size_t i = 0; i < one.size(); ++i) {
-    for (const auto& [column, cell] : one[i]) {
-      if (column == "wall_seconds" || column == "settle_wall_seconds" ||
-          column == "particle_steps_per_second") {
-        continue;  // timings
+  for (const char* other : {"two", "eight"}) {
+    const auto rows = read_csv(work_ / other / "sweep.csv");
+    ASSERT_EQ(rows.size(), 4u) << other;
+    for (std::size_t i = 0; i < one.size(); ++i) {
+      for (const auto& [column, cell] : one[i]) {
+        if (column == "wall_seconds" || column == "settle_wall_seconds" ||
+            column == "particle_steps_per_second") {
+          continue;  // timings
+        }
+        EXPECT_EQ(cell, rows[i].at(column)) << other << ", point " << i << ", " << column;
       }
-      EXPECT_EQ(cell, two[i].at(column)) << "point " << i << ", " << column;
     }
   }
   EXPECT_EQ(one[1].at("mill.speed"), "1.5");

@@ -807,6 +807,27 @@ TEST_F(Cli, ValidateReadsEveryCaseBeforeRunningAnyAndShowsAMissingPaperFigureAsN
       << set.err;
   EXPECT_FALSE(fs::exists(work_ / "runs2"));
   EXPECT_FALSE(fs::exists(work_ / "elsewhere"));
+  // The cases one after another on one thread, or together on one thread each: the same table.
+  for (const char* threads : {"1", "2"}) {
+    const Outcome again = millsim(std::string("validate cases -q -o runs-j") + threads + " -j " +
+                                  threads + " " + tiny_run);
+    EXPECT_EQ(again.status, good.status) << again.err;
+    EXPECT_EQ(read_all(work_ / (std::string("runs-j") + threads) / "validation.csv"),
+              read_all(work_ / "runs" / "validation.csv"))
+        << threads;
+  }
+  // A case whose results cannot be cleared (a directory of the user's, not empty, under a
+  // result's name) is refused before any case runs, as a sweep's point is.
+  fs::remove(work_ / "runs-j1" / "b" / "summary.json");
+  fs::create_directories(work_ / "runs-j1" / "b" / "summary.json" / "kept");
+  const Outcome taken = millsim(std::string("validate cases -o runs-j1 ") + tiny_run);
+  EXPECT_EQ(taken.status, 2) << taken.err;
+  EXPECT_NE(taken.err.find("\"runs-j1/b\" holds a directory summary.json where the run writes a "
+                           "result (not empty)"),
+            std::string::npos)
+      << taken.err;
+  EXPECT_EQ(taken.err.find("running"), std::string::npos) << taken.err;
+  EXPECT_TRUE(fs::exists(work_ / "runs-j1" / "validation.csv"));  // the earlier table stays
   // The key as the config reader reads it, blanks (a carriage return too) trimmed.
   const Outcome blank = millsim(std::string("validate cases -q -o runs2 ") + tiny_run +
                                 " --set \"$(printf 'output.directory\\r=elsewhere')\"");

@@ -1,8 +1,16 @@
 // The pure parts of `millsim sweep`: reading --vary, writing values without float noise, the
 // order of the points, their directory names, and the sweep.csv text.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <omp.h>
 
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <set>
+#include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "millsim/core/error.hpp"
@@ -244,3 +252,71 @@ TEST(Sweep, TableShowsPowersAndStatus) {
 
 }  // namespace
 }  // namespace millsim
+
+TEST(Sweep, PointsShareTheThreads) {
+  const auto expect_share = [](int threads, std::size_t points, int at_a_time, int each,
+                               const std::string& text) {
+    SCOPED_TRACE(fmt::format("{} threads, {} points", threads, points));
+    const millsim::ThreadShare share = millsim::share_threads(threads, points);
+    EXPECT_EQ(share.at_a_time, at_a_time);
+    EXPECT_EQ(share.threads_each, each);
+    EXPECT_EQ(millsim::describe(share), text);
+  };
+  expect_share(1, 5, 1, 1, "one at a time");
+  expect_share(2, 1, 1, 2, "one at a time");
+  expect_share(8, 1, 1, 8, "one at a time");
+  expect_share(2, 2, 2, 1, "2 at a time");
+  expect_share(2, 7, 2, 1, "2 at a time");
+  expect_share(8, 3, 3, 2, "3 at a time, 2 threads each");
+  expect_share(8, 2, 2, 4, "2 at a time, 4 threads each");
+  expect_share(4, 5, 4, 1, "4 at a time");
+}
+
+TEST(Sweep, SharedJobsRunEachIndexOnceOnTheirShareOfThreads) {
+  for (const millsim::ThreadShare share :
+       {millsim::ThreadShare{1, 2}, millsim::ThreadShare{3, 1}, millsim::ThreadShare{2, 2}}) {
+    SCOPED_TRACE(millsim::describe(share));
+    constexpr std::size_t count = 40;
+    std::vector<std::atomic<int>> runs(count);
+    std::vector<int> threads(count, 0);
+    std::mutex seen;
+    std::set<std::thread::id> callers;
+    millsim::run_shared(count, share, [&](std::size_t i) {
+      ++runs[i];
+      threads[i] = omp_get_max_threads();  // what the job's parallel regions would get
+      const std::lock_guard lock(seen);
+      callers.insert(std::this_thread::get_id());
+    });
+    for (std::size_t i = 0; i < count; ++i) {
+      EXPECT_EQ(runs[i].load(), 1) << i;
+      // One at a time the jobs run on this thread, with its own setting.
+      EXPECT_EQ(threads[i], share.at_a_time > 1 ? share.threads_each : omp_get_max_threads()) << i;
+    }
+    EXPECT_LE(callers.size(), static_cast<std::size_t>(share.at_a_time));
+    if (share.at_a_time == 1) {
+      EXPECT_TRUE(callers.contains(std::this_thread::get_id()));
+    }
+  }
+}
+
+TEST(Sweep, SharedJobsStopStartingAfterOneThrowsAndRethrowIt) {
+  for (const int at_a_time : {1, 2}) {
+    SCOPED_TRACE(at_a_time);
+    std::atomic<int> started{0};
+    try {
+      millsim::run_shared(1000, millsim::ThreadShare{at_a_time, 1}, [&](std::size_t i) {
+        ++started;
+        if (i == 3) throw std::runtime_error("job 3 failed");
+        // Jobs that take a while, as a point's run does: the others cannot race through the
+        // list while job 3's exception is on its way.
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      });
+      ADD_FAILURE() << "no exception";
+    } catch (const std::runtime_error& error) {
+      EXPECT_STREQ(error.what(), "job 3 failed");
+    }
+    // Jobs 0 to 3 and the one or two the other thread took meanwhile, not the rest.
+    EXPECT_GE(started.load(), 4);
+    EXPECT_LE(started.load(), at_a_time == 1 ? 4 : 8);
+  }
+}

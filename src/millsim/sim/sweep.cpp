@@ -1,16 +1,21 @@
 #include "millsim/sim/sweep.hpp"
 
 #include <fmt/format.h>
+#include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <stdexcept>
+#include <thread>
 
 #include "millsim/core/error.hpp"
 #include "millsim/io/partial_file.hpp"
@@ -409,6 +414,53 @@ std::vector<std::vector<std::string>> csv_rows(std::string_view text) {
 void write_sweep_csv(const std::filesystem::path& path, const std::vector<SweepAxis>& axes,
                      const std::vector<SweepRow>& rows) {
   write_whole_file(path, sweep_csv(axes, rows));
+}
+
+ThreadShare share_threads(int threads, std::size_t points) {
+  ThreadShare share;
+  if (threads <= 1 || points <= 1) {
+    share.threads_each = std::max(threads, 1);
+    return share;
+  }
+  share.at_a_time =
+      static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(threads), points));
+  share.threads_each = threads / share.at_a_time;
+  return share;
+}
+
+std::string describe(const ThreadShare& share) {
+  if (share.at_a_time <= 1) return "one at a time";
+  if (share.threads_each <= 1) return fmt::format("{} at a time", share.at_a_time);
+  return fmt::format("{} at a time, {} threads each", share.at_a_time, share.threads_each);
+}
+
+void run_shared(std::size_t count, const ThreadShare& share,
+                const std::function<void(std::size_t)>& job) {
+  if (share.at_a_time <= 1) {
+    for (std::size_t i = 0; i < count; ++i) job(i);
+    return;
+  }
+  std::atomic<std::size_t> next{0};
+  std::mutex failing;
+  std::exception_ptr failure;
+  const auto take_jobs = [&] {
+    omp_set_num_threads(share.threads_each);
+    for (std::size_t i = next++; i < count; i = next++) {
+      try {
+        job(i);
+      } catch (...) {
+        const std::lock_guard lock(failing);
+        if (!failure) failure = std::current_exception();
+        next = count;
+      }
+    }
+  };
+  {
+    std::vector<std::jthread> pool;
+    pool.reserve(static_cast<std::size_t>(share.at_a_time));
+    for (int t = 0; t < share.at_a_time; ++t) pool.emplace_back(take_jobs);
+  }
+  if (failure) std::rethrow_exception(failure);
 }
 
 std::string sweep_table(const std::vector<SweepAxis>& axes, const std::vector<SweepRow>& rows) {

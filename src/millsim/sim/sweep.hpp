@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -93,6 +94,33 @@ std::vector<std::vector<std::string>> csv_rows(std::string_view text);
 /// it, so that a half-written file never appears. Throws std::runtime_error if it cannot.
 void write_sweep_csv(const std::filesystem::path& path, const std::vector<SweepAxis>& axes,
                      const std::vector<SweepRow>& rows);
+
+/// How a sweep's points share the threads: so many points at a time, each on so many threads.
+struct ThreadShare {
+  int at_a_time = 1;
+  int threads_each = 1;
+};
+
+/// `points` points on `threads` threads: as many at a time as there are threads, or points if
+/// fewer, and the threads divided evenly among those (the rest left idle). So a sweep of at
+/// least as many points as threads runs them all on one thread each, a single point gets every
+/// thread, and three points on eight threads run together on two threads each.
+ThreadShare share_threads(int threads, std::size_t points);
+
+/// "one at a time", "4 at a time" or "3 at a time, 2 threads each".
+std::string describe(const ThreadShare& share);
+
+/// Calls `job(i)` for every i below `count`, `share.at_a_time` at a time, each call's
+/// parallel regions on `share.threads_each` threads; one after another on this thread if
+/// `share.at_a_time` is 1. The jobs run on a pool of plain threads, each taking the next i: to
+/// OpenMP each is an initial thread, whose parallel regions (a run's World's) run on a team
+/// that libgomp keeps from one region to the next. (Nested inside an OpenMP region, a job's
+/// team would be made afresh at every region, i.e. at every step, since libgomp reuses idle
+/// threads for outermost regions only: two points of the 996-ball slab on two threads each
+/// barely advanced that way.) After a job throws, no job starts; the first exception is
+/// rethrown once the running ones have finished.
+void run_shared(std::size_t count, const ThreadShare& share,
+                const std::function<void(std::size_t)>& job);
 
 /// The table printed at the end of a sweep: the varied values, power_kw,
 /// power_dissipation_kw, energy_balance_error and the status of each point.
