@@ -378,6 +378,9 @@ int validate_command(const std::string& directory, const JobOptions& options) {
           root_location, name.string()));
     }
   }
+  // OUT itself, if it is there, as a sweep checks its own: one that cannot take files is
+  // refused before any case runs (a case's directory not yet made has nothing to check).
+  check_output_directory(root, root_location, {"validation.csv"});
   std::vector<MillPlan> plans;
   for (const auto& path : cases) {
     if (path.stem() == table_path.filename()) {
@@ -438,9 +441,11 @@ int validate_command(const std::string& directory, const JobOptions& options) {
       if (!options.quiet) fmt::print(stderr, "running {} ...\n", config.source);
     };
     const bool progress = !options.quiet && share.at_a_time <= 1;
+    // Each case's warnings name it: the cases may run together.
+    const std::string context = fmt::format("case {}", config.source);
     const MillResult result = config.dimension == 2
-                                  ? run_job<2>(plan, root_location, progress, started)
-                                  : run_job<3>(plan, root_location, progress, started);
+                                  ? run_job<2>(plan, root_location, progress, started, context)
+                                  : run_job<3>(plan, root_location, progress, started, context);
     rows[i] = {config.reference->case_name, config.reference->measured_kw, result.power_kw,
                config.reference->tolerance, config.reference->paper_kw};
   });

@@ -113,7 +113,10 @@ TEST_F(SweepPowerCurve, ResultsDoNotDependOnTheThreadsAndEveryPointHasItsDirecto
   const Outcome serial = millsim(sweep + " -j 1 --out one");
   const Outcome parallel = millsim(sweep + " -j 2 --out two");
   // Fewer points than threads: the points together, the threads shared among them (the
-  // opening line says how; -q leaves it out).
+  // opening line says how; -q leaves it out). This mill is too small for its step to use a
+  // second thread: what is checked here is the jobs' pool and bookkeeping; run_shared's giving
+  // each job its share of threads is unit-tested (test_sweep.cpp), and the same bits at any
+  // thread count in test_determinism.cpp.
   std::string shared = sweep + " -j 8 --out eight";
   shared.erase(shared.find(" -q "), 3);
   const Outcome nested = millsim(shared);

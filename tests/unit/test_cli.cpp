@@ -816,6 +816,11 @@ TEST_F(Cli, ValidateReadsEveryCaseBeforeRunningAnyAndShowsAMissingPaperFigureAsN
               read_all(work_ / "runs" / "validation.csv"))
         << threads;
   }
+  // Again into the first one's directory: its results are cleared and replaced, not refused.
+  const Outcome over = millsim(std::string("validate cases -q -o runs ") + tiny_run);
+  EXPECT_EQ(over.status, good.status) << over.err;
+  EXPECT_EQ(read_all(work_ / "runs" / "validation.csv"),
+            read_all(work_ / "runs-j1" / "validation.csv"));
   // A case whose results cannot be cleared (a directory of the user's, not empty, under a
   // result's name) is refused before any case runs, as a sweep's point is.
   fs::remove(work_ / "runs-j1" / "b" / "summary.json");

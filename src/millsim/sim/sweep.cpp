@@ -15,6 +15,7 @@
 #include <optional>
 #include <set>
 #include <stdexcept>
+#include <system_error>
 #include <thread>
 
 #include "millsim/core/error.hpp"
@@ -458,7 +459,17 @@ void run_shared(std::size_t count, const ThreadShare& share,
   {
     std::vector<std::jthread> pool;
     pool.reserve(static_cast<std::size_t>(share.at_a_time));
-    for (int t = 0; t < share.at_a_time; ++t) pool.emplace_back(take_jobs);
+    try {
+      for (int t = 0; t < share.at_a_time; ++t) pool.emplace_back(take_jobs);
+    } catch (const std::system_error&) {
+      // No more threads to be had (a limit on the processes, say): those made take every job;
+      // with none, this thread does, on its own setting once done.
+      if (pool.empty()) {
+        const int own = omp_get_max_threads();
+        take_jobs();
+        omp_set_num_threads(own);
+      }
+    }
   }
   if (failure) std::rethrow_exception(failure);
 }
