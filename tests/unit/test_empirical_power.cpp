@@ -548,5 +548,24 @@ TEST(EmpiricalPower, SummaryJsonHoldsEveryScalarWithItsValueInItsNestedObject) {
   EXPECT_TRUE(read.numbers.count("empirical.inputs.diameter_m") == 1);
 }
 
+TEST(EmpiricalPower, SummaryNumbersAreWrittenInTheirShortestExactForm) {
+  // What toml++'s writer gives with GCC (17 significant digits), and what is kept.
+  EXPECT_EQ(shortest_json_numbers(
+                R"({"a" : 0.050799999999999998, "b" : -1.0000000000000001e-05, "c" : 3.0, )"
+                R"("d" : 75, "e" : [ 0.16070020622622724, -0.1633766397445303 ], )"
+                R"("f" : "0.050799999999999998 \"1.5000000000000000\" x", "g" : 1e+300})"),
+            R"({"a" : 0.0508, "b" : -1e-05, "c" : 3.0, )"
+            R"("d" : 75, "e" : [ 0.16070020622622724, -0.1633766397445303 ], )"
+            R"("f" : "0.050799999999999998 \"1.5000000000000000\" x", "g" : 1e+300})");
+  // The written summary: the disc diameter as configured.
+  MillResult result;
+  result.plan = plan_mill(parse_mill_config(builtin_example_toml, "lab-mill-2d.toml", {}));
+  result.power_kw = 0.1 + 0.2;  // 0.30000000000000004: shortest is not rounding
+  const std::string json = summary_json(result);
+  EXPECT_NE(json.find("\"diameter_m\" : 0.0508,"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"power_kw\" : 0.30000000000000004,"), std::string::npos) << json;
+  // (That every number reads back to its value: SummaryJsonHoldsEveryScalarWithItsValue...)
+}
+
 }  // namespace
 }  // namespace millsim

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -326,6 +327,44 @@ std::vector<std::pair<std::string, double>> summary_columns(const MillResult& re
   return columns;
 }
 
+std::string shortest_json_numbers(std::string_view json) {
+  std::string out;
+  out.reserve(json.size());
+  std::size_t k = 0;
+  while (k < json.size()) {
+    const char c = json[k];
+    if (c == '"') {  // a string, copied whole (a backslash escapes the next character)
+      const std::size_t start = k++;
+      while (k < json.size() && json[k] != '"') k += json[k] == '\\' ? 2 : 1;
+      k = std::min(json.size(), k + 1);
+      out.append(json.substr(start, k - start));
+      continue;
+    }
+    if (c != '-' && (c < '0' || c > '9')) {
+      out.push_back(c);
+      ++k;
+      continue;
+    }
+    const std::size_t start = k;
+    while (k < json.size() &&
+           std::string_view("0123456789+-.eE").find(json[k]) != std::string_view::npos) {
+      ++k;
+    }
+    const std::string_view token = json.substr(start, k - start);
+    double value = 0.0;
+    const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
+    const bool fractional = token.find_first_of(".eE") != std::string_view::npos;
+    if (!fractional || error != std::errc{} || end != token.data() + token.size()) {
+      out.append(token);  // an integer, or not a number this pass understands: as written
+      continue;
+    }
+    std::string shortest = fmt::format("{}", value);
+    if (shortest.find_first_of(".e") == std::string::npos) shortest += ".0";
+    out += shortest;
+  }
+  return out;
+}
+
 std::string summary_json(const MillResult& r) {
   const MillPlan& plan = r.plan;
   const MillConfig& c = plan.config;
@@ -361,7 +400,7 @@ std::string summary_json(const MillResult& r) {
   }
   std::ostringstream text;
   text << toml::json_formatter{summary} << "\n";
-  return text.str();
+  return shortest_json_numbers(text.str());
 }
 
 std::string summary_line(const MillResult& r) {

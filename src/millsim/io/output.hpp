@@ -54,6 +54,12 @@ void write_results(const std::filesystem::path& directory, const MillResult& res
 /// The summary as JSON text (what summary.json holds).
 std::string summary_json(const MillResult& result);
 
+/// JSON text (as toml++'s writer makes it) with every non-integer number in the shortest form
+/// that reads back to the same double: 0.0508, not 0.050799999999999998 (toml++ built with GCC
+/// writes 17 significant digits). A number that was written with a point keeps one (3.0).
+/// Strings are left as they are.
+std::string shortest_json_numbers(std::string_view json);
+
 /// Every number of summary.json as (name, value), in a fixed order; a number inside a nested
 /// object is named with a dot ("reference.measured_power_kw"). Arrays (`discs`/`balls`,
 /// `charge_centre_of_mass_m`) are not in the list. summary.json's numbers are written from

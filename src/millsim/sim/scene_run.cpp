@@ -16,6 +16,7 @@
 #include "millsim/core/constants.hpp"
 #include "millsim/core/error.hpp"
 #include "millsim/core/version.hpp"
+#include "millsim/io/output.hpp"
 #include "millsim/io/partial_file.hpp"
 #include "millsim/sim/charge.hpp"
 
@@ -125,7 +126,7 @@ std::string summary_json(const SceneResult& r) {
   }
   std::ostringstream text;
   text << toml::json_formatter{summary} << "\n";
-  return text.str();
+  return shortest_json_numbers(text.str());
 }
 
 }  // namespace
