@@ -10,7 +10,9 @@
 #include <cerrno>
 #include <charconv>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -783,6 +785,47 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
   return 0;
 }
 
+/// Whether `text` is a whole number of threads from 1 to 1024, all of it.
+bool is_thread_count(std::string_view text) {
+  int value = 0;
+  const char* end = text.data() + text.size();
+  const auto [stop, error] = std::from_chars(text.data(), end, value);
+  return error == std::errc{} && stop == end && value >= 1 && value <= 1024;
+}
+
+/// What is wrong with the environment's OMP_NUM_THREADS, if anything. The OpenMP runtime reads
+/// it when the first thread count is asked for or set, even under -j, and a value it cannot
+/// read it does not refuse: with "abc" libomp warned and then, one run in three, hung or
+/// aborted. So the value must be what OpenMP allows, a list of thread counts, one per level of
+/// nesting, separated by commas (millsim's jobs use the first); under -j, whose count replaces
+/// it, the counts may be any size.
+std::optional<std::string> omp_num_threads_problem(bool threads_given) {
+  const char* set = std::getenv("OMP_NUM_THREADS");
+  if (set == nullptr) return std::nullopt;
+  const std::string_view value(set);
+  bool readable = true;
+  bool within = true;
+  std::size_t from = 0;
+  while (readable) {
+    const std::size_t comma = value.find(',', from);
+    const std::string_view count =
+        value.substr(from, comma == std::string_view::npos ? std::string_view::npos : comma - from);
+    std::uint64_t number = 0;
+    const auto [stop, error] = std::from_chars(count.data(), count.data() + count.size(), number);
+    readable = !count.empty() && stop == count.data() + count.size() &&
+               (error == std::errc{} || error == std::errc::result_out_of_range) && number >= 1;
+    within = within && readable && is_thread_count(count);
+    if (comma == std::string_view::npos) break;
+    from = comma + 1;
+  }
+  if (readable && (within || threads_given)) return std::nullopt;
+  return fmt::format(
+      "environment: OMP_NUM_THREADS=\"{}\" is not allowed; allowed: a whole number of threads "
+      "from 1 to 1024 (or such numbers separated by commas, one per level of nesting), or "
+      "OMP_NUM_THREADS unset{}",
+      value, readable ? " or -j/--threads N given in its place" : "");
+}
+
 /// --set, -j and -q; `quiet` says what -q leaves of the command's output.
 void add_job_options(CLI::App& command, JobOptions& options, const std::string& quiet) {
   command.add_option("--set", options.overrides,
@@ -794,10 +837,7 @@ void add_job_options(CLI::App& command, JobOptions& options, const std::string& 
       ->check(CLI::Validator(
           [](const std::string& text) -> std::string {
             // CLI11's own Range says "Value abc not in range" of a word that is no number.
-            int value = 0;
-            const char* end = text.data() + text.size();
-            const auto [stop, error] = std::from_chars(text.data(), end, value);
-            if (error != std::errc{} || stop != end || value < 1 || value > 1024) {
+            if (!is_thread_count(text)) {
               return fmt::format(
                   "\"{}\" is not allowed; allowed: a whole number of threads "
                   "from 1 to 1024",
@@ -892,6 +932,13 @@ int run_program(int argc, char** argv) {
       fmt::print(stderr, "millsim: error: command line: {}; allowed: see {}\n", what, help);
     }
     return 2;
+  }
+  if (run->parsed() || validate->parsed() || sweep->parsed()) {
+    // Before any OpenMP call (omp_set_num_threads among them) reads OMP_NUM_THREADS.
+    if (const auto problem = omp_num_threads_problem(options.threads > 0)) {
+      fmt::print(stderr, "millsim: error: {}\n", *problem);
+      return 2;
+    }
   }
   if (options.threads > 0) omp_set_num_threads(options.threads);
   // An empty path is a mistake (an unset shell variable), not a request for the default.

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <iterator>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -583,6 +584,67 @@ TEST_F(Cli, RefusesAThreadCountThatIsNoWholeNumberFromOneTo1024) {
     expect_refused(o, {"--threads: \"" + threads +
                        "\" is not allowed; allowed: a whole number of threads from 1 to 1024"});
   }
+}
+
+/// An environment variable set to a value while it lives, then as it was.
+class EnvironmentVariable {
+ public:
+  EnvironmentVariable(const char* name, const std::string& value) : name_(name) {
+    if (const char* was = std::getenv(name)) was_ = was;
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~EnvironmentVariable() {
+    if (was_) {
+      ::setenv(name_, was_->c_str(), 1);
+    } else {
+      ::unsetenv(name_);
+    }
+  }
+  EnvironmentVariable(const EnvironmentVariable&) = delete;
+  EnvironmentVariable& operator=(const EnvironmentVariable&) = delete;
+
+ private:
+  const char* name_;
+  std::optional<std::string> was_;
+};
+
+TEST_F(Cli, RefusesAnOmpNumThreadsTheRuntimeCannotReadOrThatExceeds1024) {
+  // libomp read "abc" with a warning and then, one run in three, hung or aborted.
+  for (const std::string value :
+       {"abc", "", "0", "2.5", "4x", " 2", "2,", ",2", "-3", "2,abc", "99999999999999999999999"}) {
+    const EnvironmentVariable set("OMP_NUM_THREADS", value);
+    for (const std::string threads : {"", "-j 1 "}) {
+      expect_refused(run_config(base_config, threads + tiny_run),
+                     {"environment: OMP_NUM_THREADS=\"" + value +
+                      "\" is not allowed; allowed: a whole number of threads from 1 to 1024"});
+    }
+  }
+  for (const std::string value : {"1025", "2,2000"}) {
+    const EnvironmentVariable set("OMP_NUM_THREADS", value);
+    expect_refused(run_config(base_config, tiny_run),
+                   {"OMP_NUM_THREADS=\"" + value + "\" is not allowed",
+                    "or -j/--threads N given in its place\n"});
+    // -j's count replaces it.
+    const Outcome o = run_config(base_config, std::string("-j 1 ") + tiny_run);
+    EXPECT_EQ(o.status, 0) << value << ": " << o.err;
+    fs::remove_all(work_ / "out");
+  }
+  for (const std::string value : {"1", "2,1", "1024"}) {
+    const EnvironmentVariable set("OMP_NUM_THREADS", value);
+    const Outcome o = run_config(base_config, tiny_run);
+    EXPECT_EQ(o.status, 0) << value << ": " << o.err;
+    fs::remove_all(work_ / "out");
+  }
+  // Sweep and validate check it too; info, which runs nothing, does not.
+  const EnvironmentVariable set("OMP_NUM_THREADS", "abc");
+  for (const std::string command :
+       {"sweep mill.toml -o out --vary mill.speed=0.5,0.6 ", "validate . -o out "}) {
+    const Outcome o = millsim(command + tiny_run);
+    EXPECT_EQ(o.status, 2) << command << ": " << o.err;
+    EXPECT_TRUE(o.err.starts_with("millsim: error: environment: OMP_NUM_THREADS=\"abc\"")) << o.err;
+    EXPECT_FALSE(fs::exists(work_ / "out")) << command;
+  }
+  EXPECT_EQ(millsim("info mill.toml").status, 0);
 }
 
 TEST_F(Cli, AnOptionTheCommandDoesNotTakePointsToThatCommandsHelp) {
