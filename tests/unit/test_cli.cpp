@@ -218,6 +218,9 @@ TEST_F(Cli, RefusesLiftersThatOverlap) {
   const std::string text = with(base_config, "width", "width = 0.33");
   expect_refused(run_config(text),
                  {at_line(text, "width"), "mill.lifters.width", "0.33 is not allowed", "overlap"});
+  // The limit in full, 2π (0.45 − 0.04) / 8 m, not rounded to four digits (0.322).
+  const std::string past_limit = with(base_config, "width", "width = 0.32202");
+  expect_refused(run_config(past_limit), {"0.32202 is not allowed", "> 0 and < 0.32201324699"});
 }
 
 TEST_F(Cli, RefusesLiftersThatFillTheMill) {

@@ -160,7 +160,7 @@ void read_lifters(TableReader lifters, MillConfig& config) {
   const double widest = inner_circumference / config.lifter_count;
   config.lifter_width = lifters.number(
       "width", std::nullopt,
-      fmt::format("a number of metres > 0 and < {:.4g} (wider, {} lifters {} m high would "
+      fmt::format("a number of metres > 0 and < {} (wider, {} lifters {} m high would "
                   "overlap at their inner faces)",
                   widest, config.lifter_count, config.lifter_height),
       [&](double w) { return w > 0.0 && w < widest; });
@@ -220,7 +220,7 @@ void read_cones(TableReader& section, MillConfig& config) {
   const double longest = 0.5 * config.diameter * std::tan(config.cone_angle_degrees * pi / 180.0);
   config.cone_length = section.number(
       "cone_length", std::nullopt,
-      fmt::format("a number of metres > 0 and < {:.4g} (longer, a cone at {} degrees from a mill "
+      fmt::format("a number of metres > 0 and < {} (longer, a cone at {} degrees from a mill "
                   "of {} m diameter would reach the axis)",
                   longest, config.cone_angle_degrees, config.diameter),
       [&](double l) { return l > 0.0 && l < longest; });

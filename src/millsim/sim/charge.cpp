@@ -95,12 +95,12 @@ MillPlan plan_mill(const MillConfig& config) {
     plan.speed_rpm = *config.speed_rpm;
     plan.speed_fraction = plan.speed_rpm / plan.critical_speed_rpm;
     if (plan.speed_fraction > most_speed_fraction) {
-      throw InputError(fmt::format(
-          "{}: mill.speed_rpm: {} rpm is {:.3g} times this mill's critical speed, {:.4g} rpm; "
-          "allowed: > 0 and at most {} times critical, {:.4g} rpm (as for mill.speed)",
-          config.location_of("mill.speed_rpm"), plan.speed_rpm, plan.speed_fraction,
-          plan.critical_speed_rpm, most_speed_fraction,
-          most_speed_fraction * plan.critical_speed_rpm));
+      throw InputError(
+          fmt::format("{}: mill.speed_rpm: {} rpm is {} times this mill's critical speed, {} rpm; "
+                      "allowed: > 0 and at most {} times critical, {} rpm (as for mill.speed)",
+                      config.location_of("mill.speed_rpm"), plan.speed_rpm, plan.speed_fraction,
+                      plan.critical_speed_rpm, most_speed_fraction,
+                      most_speed_fraction * plan.critical_speed_rpm));
     }
   }
   plan.angular_speed = plan.speed_rpm * 2.0 * pi / 60.0;
