@@ -385,6 +385,14 @@ int validate_command(const std::string& directory, const JobOptions& options) {
   check_output_directory(root, root_location, {"validation.csv"});
   std::vector<MillPlan> plans;
   for (const auto& path : cases) {
+    // A case's results go to OUT/<its stem>: "...toml" has the stem "..", whose results went
+    // to OUT's parent and cleared what a run's results replace there (snapshots/ among them).
+    if (path.stem() == "." || path.stem() == "..") {
+      throw millsim::InputError(fmt::format(
+          "{}: a case named \"{}\" would write its results to {}, outside {}; allowed: a case "
+          "file whose name without .toml is neither . nor ..",
+          path.string(), path.stem().string(), (root / path.stem()).string(), root.string()));
+    }
     if (path.stem() == table_path.filename()) {
       throw millsim::InputError(fmt::format(
           "{}: a case named {} would write its results where validate writes its table, {}; "

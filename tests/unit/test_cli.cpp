@@ -751,6 +751,26 @@ TEST_F(Cli, ValidateRefusesWhatWouldTakeTheNameOfItsTableBeforeAnyCaseRuns) {
             std::string::npos)
       << named.err;
   EXPECT_FALSE(fs::exists(work_ / "runs"));
+  fs::remove(work_ / "cases" / "validation.csv.toml");
+  // Cases whose results would go to OUT itself ("..toml") or to its parent ("...toml"), where
+  // clearing a run's earlier results would remove the user's snapshots/.
+  fs::create_directories(work_ / "parent" / "snapshots");
+  std::ofstream(work_ / "parent" / "snapshots" / "notes.txt") << "kept\n";
+  for (const std::string name : {"..toml", "...toml"}) {
+    fs::copy_file(work_ / "cases" / "a.toml", work_ / "cases" / name);
+    const Outcome dots = millsim(std::string("validate cases -o parent/runs ") + tiny_run);
+    EXPECT_EQ(dots.status, 2) << name << ": " << dots.err;
+    const std::string stem = name.substr(0, name.size() - 5);
+    EXPECT_NE(dots.err.find("cases/" + name + ": a case named \"" + stem +
+                            "\" would write its results to parent/runs/" + stem +
+                            ", outside parent/runs; allowed: a case file whose name without "
+                            ".toml is neither . nor .."),
+              std::string::npos)
+        << dots.err;
+    EXPECT_FALSE(fs::exists(work_ / "parent" / "runs"));
+    EXPECT_EQ(read_all(work_ / "parent" / "snapshots" / "notes.txt"), "kept\n");
+    fs::remove(work_ / "cases" / name);
+  }
 }
 
 TEST_F(Cli, ValidateReadsEveryCaseBeforeRunningAnyAndShowsAMissingPaperFigureAsNa) {
