@@ -133,6 +133,14 @@ TEST(Sweep, NumbersAreWrittenWithoutFloatNoise) {
   EXPECT_EQ(decimal_text(0.3 + 4 * 0.1, 1), "0.7");
   EXPECT_EQ(decimal_text(0.1 + 0.2, 2), "0.3");
   EXPECT_EQ(decimal_text(2.0, 1), "2");
+  // Steps too small for 30 places: rounded to significant digits, not to "0".
+  EXPECT_EQ(decimal_places("1e-40"), 40);
+  EXPECT_EQ(decimal_text(1e-40 + 2 * 1e-40, 40), "3e-40");
+  EXPECT_EQ(decimal_text(0.3e-35 + 6 * 0.1e-35, 36), "9e-36");
+  EXPECT_EQ(parse_vary("charge.porosity=0:2e-40:1e-40").values,
+            (std::vector<std::string>{"0", "1e-40", "2e-40"}));
+  EXPECT_EQ(parse_vary("mill.speed=1e-320:2e-320:1e-320").values,
+            (std::vector<std::string>{"1e-320", "2e-320"}));
   EXPECT_EQ(decimal_text(-1e-17, 1), "0");
   EXPECT_EQ(decimal_text(0.125, 3), "0.125");
 }

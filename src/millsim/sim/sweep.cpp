@@ -38,8 +38,12 @@ constexpr std::string_view vary_allowed =
 /// A range's values are counted as whole steps from START; STOP is included when it is within
 /// this fraction of a step of the last one (it rarely lands exactly: 0.3 + 6 × 0.1 ≠ 0.9).
 constexpr double stop_tolerance_steps = 1e-9;
-/// More decimals than a double can hold are noise.
+/// Places written in fixed notation at most; a range that needs more (a step of 1e-40, say)
+/// is rounded to significant digits instead (decimal_text).
 constexpr int max_decimals = 30;
+/// Significant digits a range's values keep when they need more than max_decimals places:
+/// enough to drop the noise of START + i × STEP (0.3 + 6 × 0.1), not the values typed.
+constexpr int range_significant_digits = 15;
 
 std::string_view trim(std::string_view text) {
   const auto first = text.find_first_not_of(" \t");
@@ -247,11 +251,16 @@ int decimal_places(std::string_view number) {
   const auto point = number.find('.');
   const int fraction =
       point == std::string_view::npos ? 0 : static_cast<int>(number.size() - point - 1);
-  return std::clamp(fraction - exponent, 0, max_decimals);
+  // (A number of a double's range needs at most some 1100 places: 4.9e-324 written out.)
+  return std::clamp(fraction - exponent, 0, 2000);
 }
 
 std::string decimal_text(double value, int decimals) {
-  const std::string rounded = fmt::format("{:.{}f}", value, std::clamp(decimals, 0, max_decimals));
+  // Rounded to a fixed number of places, 1e-40 + 1e-40 would be written "0": past
+  // max_decimals, to significant digits.
+  const std::string rounded = decimals > max_decimals
+                                  ? fmt::format("{:.{}g}", value, range_significant_digits)
+                                  : fmt::format("{:.{}f}", value, std::max(decimals, 0));
   double exact = 0.0;
   std::from_chars(rounded.data(), rounded.data() + rounded.size(), exact);
   if (exact == 0.0) exact = 0.0;  // no "-0"

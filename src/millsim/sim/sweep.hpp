@@ -33,7 +33,8 @@ SweepAxis parse_vary(std::string_view argument);
 int decimal_places(std::string_view number);
 
 /// `value` rounded to `decimals` places and written in the fewest digits that read back as
-/// that rounded value: (0.3 + 4 × 0.1, 1) gives "0.7", not "0.7000000000000001".
+/// that rounded value: (0.3 + 4 × 0.1, 1) gives "0.7", not "0.7000000000000001". Past 30
+/// places (a value of 2e-40), rounded to 15 significant digits instead.
 std::string decimal_text(double value, int decimals);
 
 /// Throws InputError when two axes vary the same key or the sweep has more than
