@@ -275,6 +275,35 @@ void expect_has(const std::string& message, std::initializer_list<std::string_vi
   }
 }
 
+TEST(MillPlan, RefusesAOneSizeChargePastTheJammingLimitOfRandomPlacementBeforePlacingIt) {
+  // The lab mill's discs cover 0.8 J of its cross-section: 173 discs at J = 0.69 cover
+  // 173 × π 0.0254² / (π 0.45²) = 0.5512, past the 0.5470735 that discs placed one by one at
+  // random can reach; 171 at J = 0.68 cover 0.5448 and are left to the placement.
+  expect_has(plan_error(lab_mill({"charge.filling=0.69"})),
+             {"charge.filling: 173 discs of 0.0508 m would take 0.551 of the mill's cross-section",
+              "more than the 0.5470735", "cannot be placed", "allowed: a filling below about"});
+  EXPECT_EQ(plan_mill(lab_mill({"charge.filling=0.68"})).particle_count, 171);
+  // Found at once however many: 2.9 million discs at J = 0.95 in a 100 m mill, whose placement
+  // had not given up after 15 minutes.
+  expect_has(plan_error(lab_mill({"mill.diameter=100", "charge.filling=0.95"})),
+             {"charge.filling: 2945", "would take 0.76"});
+  // Spheres: 0.6 J of a whole mill 0.15 m long, past 0.384130 from J = 0.65 (542 balls, 0.390).
+  const std::vector<std::string> whole_3d = {"simulation.dimension=3", "mill.length=0.15"};
+  auto in_3d = [&](const std::string& filling) {
+    std::vector<std::string> overrides = whole_3d;
+    overrides.push_back(filling);
+    return lab_mill(overrides);
+  };
+  expect_has(plan_error(in_3d("charge.filling=0.65")),
+             {"542 balls of 0.0508 m would take 0.390 of the mill's volume", "0.38413",
+              "and this porosity"});
+  EXPECT_GT(plan_mill(in_3d("charge.filling=0.62")).particle_count, 0);
+  // A graded charge is not held to one size's limit (its small balls fill the large ones' gaps).
+  MillConfig graded = graded_lab_mill();
+  graded.filling = 0.75;
+  EXPECT_GT(plan_mill(graded).particle_count, 0);
+}
+
 TEST(MillPlan, RefusesMillsThatCannotRunNamingTheKey) {
   // Critical speed 45.900339 rpm (above): at most 5 times that, 229.5 rpm.
   MillConfig in_rpm = lab_mill();
