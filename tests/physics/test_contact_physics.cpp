@@ -196,6 +196,50 @@ TEST(ContactHeadOn, DiscDiscWithoutTensionFollowsTheNoTensionOscillator) {
   }
 }
 
+// The deepest overlap of a head-on impact of the linear spring-dashpot, from
+// δ(t) = (v0/ω_d) e^(−ζ ω0 t) sin(ω_d t) at its maximum, tan(ω_d t) = ω_d / (ζ ω0):
+// δ_max = (v0 / ω0) exp(−ζ / sqrt(1 − ζ²) · atan(sqrt(1 − ζ²) / ζ)), with ω0² = k_n / m* and
+// ζ = −ln e / sqrt(ln² e + π²) (MODEL.md §3's c_n over 2 sqrt(k_n m*)). The normal force is
+// compressive until the maximum, so the no-tension rule does not change it.
+// World::largest_overlap_fraction, taken after every step, reaches it over the disc's radius
+// (the smaller of two equal discs; a disc against a wall).
+double deepest_overlap(const ContactMaterial& material, double reduced) {
+  const double omega0 = std::sqrt(material.normal_stiffness / reduced);
+  const double log_e = std::log(material.restitution);
+  const double zeta = -log_e / std::sqrt(log_e * log_e + pi * pi);
+  const double root = std::sqrt(1.0 - zeta * zeta);
+  return approach_speed / omega0 * std::exp(-zeta / root * std::atan(root / zeta));
+}
+
+template <typename Overlap>
+double largest_overlap_fraction_over_an_impact(World<2>& world, Overlap overlap) {
+  double largest = world.largest_overlap_fraction();
+  for (long n = 0; n < 100000 && (n < 100 || overlap(world) > 0.0); ++n) {
+    world.step();
+    largest = std::max(largest, world.largest_overlap_fraction());
+  }
+  return largest;
+}
+
+TEST(ContactHeadOn, TheLargestOverlapFractionIsTheDeepestOverlapOverTheRadius) {
+  for (const double e : restitutions) {
+    SCOPED_TRACE(e);
+    const ContactMaterial material = material_with(e);
+    // Equal discs of 2 kg: m* = 1 kg; at t_c/200 a step samples the maximum to 1.2e-4 of it.
+    World<2> pair = disc_disc_world(material, 2.0, 2.0, false);
+    const double expected_pair = deepest_overlap(material, 1.0) / disc_radius;
+    EXPECT_NEAR(largest_overlap_fraction_over_an_impact(pair, disc_disc_overlap), expected_pair,
+                1e-3 * expected_pair);
+    World<2> wall = disc_wall_world(material, 2.0, false);
+    const double expected_wall = deepest_overlap(material, 2.0) / disc_radius;
+    EXPECT_NEAR(largest_overlap_fraction_over_an_impact(wall, disc_wall_overlap), expected_wall,
+                1e-3 * expected_wall);
+  }
+  // Apart, nothing overlaps.
+  World<2> apart = disc_disc_world(material_with(0.5), 2.0, 2.0, false);
+  EXPECT_EQ(apart.largest_overlap_fraction(), 0.0);
+}
+
 TEST(ContactHeadOn, DiscWallWithTensionFollowsCorkum) {
   const double mass = 2.0;
   for (const double e : restitutions) {

@@ -1,6 +1,7 @@
 // The millsim program on bad input: each refusal exits with status 2, prints one message on
 // stderr ("millsim: error: FILE:LINE: dotted.key: ...; allowed: ...") and writes nothing. Each
 // test runs the built program in a fresh temporary directory.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <stdlib.h>
 #include <sys/stat.h>
@@ -111,6 +112,42 @@ TEST_F(Cli, ATinyRunOfTheBaseConfigWritesItsResults) {
                 .find("\"millsim_version\" : \"" + millsim::version_text() + "\""),
             std::string::npos)
       << read_all(work_ / "out" / "summary.json");
+}
+
+TEST_F(Cli, ContactsThatOverlapDeeplyAreWarnedOfAndTheDeepestIsInTheSummary) {
+  // MODEL.md's springs (4e5 N/m) in this mill: no warning, a few per cent of a radius.
+  const Outcome sound = run_config(base_config, tiny_run);
+  ASSERT_EQ(sound.status, 0) << sound.err;
+  EXPECT_EQ(sound.err.find("overlapped"), std::string::npos) << sound.err;
+  const std::string summary = read_all(work_ / "out" / "summary.json");
+  const std::smatch found = [&] {
+    std::smatch m;
+    std::regex_search(summary, m, std::regex("\"largest_overlap_fraction\" : ([0-9.e+-]+)"));
+    return m;
+  }();
+  ASSERT_EQ(found.size(), 2u) << summary;
+  const double sound_fraction = std::stod(found[1].str());
+  EXPECT_GT(sound_fraction, 0.0);
+  EXPECT_LT(sound_fraction, 0.5);
+  // Springs of 100 N/m: a disc of 0.52 kg sinks 5 cm under its own weight, twice its radius
+  // (seen: 5.1 radii), and through the shell.
+  fs::remove_all(work_ / "out");
+  std::string soft_springs;
+  for (const char* contact : {"ball_ball", "ball_wall"}) {
+    for (const char* spring : {"normal_stiffness", "tangential_stiffness"}) {
+      soft_springs += fmt::format(" --set materials.{}.{}=100", contact, spring);
+    }
+  }
+  const Outcome soft = run_config(base_config, tiny_run + soft_springs);
+  ASSERT_EQ(soft.status, 0) << soft.err;
+  EXPECT_NE(soft.err.find("millsim: warning: results in out/: contacts overlapped by up to "),
+            std::string::npos)
+      << soft.err;
+  EXPECT_NE(soft.err.find("of the smaller ball's radius (more than 50 %): the springs are soft "
+                          "for these balls and this mill (materials.*.normal_stiffness), balls "
+                          "sink into each other and may pass through one another or a wall"),
+            std::string::npos)
+      << soft.err;
 }
 
 TEST_F(Cli, VersionPrintsTheVersionAndTheSourceRevision) {

@@ -191,6 +191,7 @@ std::vector<SummaryNumber> summary_numbers(const MillResult& r) {
       {"mill_charge_mass_kg", plan.mill_charge_mass},
       {"power_scale", plan.power_scale},
       {"charge_orbital_speed_ratio", r.orbital_speed_ratio},
+      {"largest_overlap_fraction", r.largest_overlap_fraction},
       {"dimension", count(c.dimension), true},
   };
   // Only where the charge has a toe and a shoulder (not when it lines the whole shell).
@@ -455,6 +456,14 @@ std::vector<std::string> result_warnings(const MillResult& r) {
                            "more revolutions than are measured"
                          : "its energy changed over the window: run more revolutions before "
                            "measuring, or measure more"));
+  }
+  if (r.largest_overlap_fraction > doubtful_overlap_fraction) {
+    warnings.push_back(fmt::format(
+        "contacts overlapped by up to {:.0f} % of the smaller ball's radius (more than {:.0f} %): "
+        "the springs are soft for these balls and this mill (materials.*.normal_stiffness), "
+        "balls sink into each other{}, and the results are doubtful",
+        100.0 * r.largest_overlap_fraction, 100.0 * doubtful_overlap_fraction,
+        r.largest_overlap_fraction >= 1.0 ? " and may pass through one another or a wall" : ""));
   }
   return warnings;
 }

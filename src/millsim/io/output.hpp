@@ -79,9 +79,14 @@ inline constexpr double doubtful_energy_balance_error = 0.05;
 /// Power by torque and by dissipation further apart than this, relative to the larger, is
 /// reported as doubtful: the measured window was not steady.
 inline constexpr double doubtful_power_disagreement = 0.10;
+/// A contact that overlapped more than this fraction of the smaller radius is reported as
+/// doubtful: the linear spring assumes small overlaps, and from 1 on a ball may pass through
+/// another or through a wall. (MODEL.md's springs give 0.02-0.32 in the validation cases.)
+inline constexpr double doubtful_overlap_fraction = 0.5;
 
 /// What in the results says they are doubtful, one sentence each (none for a sound run): an
-/// energy balance that does not close, power by torque and by dissipation that disagree.
+/// energy balance that does not close, power by torque and by dissipation that disagree,
+/// contacts that overlapped deeply.
 std::vector<std::string> result_warnings(const MillResult& result);
 
 }  // namespace millsim

@@ -1,5 +1,6 @@
 #include "millsim/sim/mill_run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -92,6 +93,7 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
     if (progress && world.steps() % 2000 == 0) progress(world.time(), plan.total_time, 0.0);
   }
   result.settled_kinetic_energy = world.kinetic_energy();
+  result.largest_overlap_fraction = world.largest_overlap_fraction();
   result.settle_wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
@@ -132,6 +134,8 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
     if (now_turned >= series_angle * static_cast<double>(result.series.size() + 1)) {
       const EnergySample now = sample(world);
       result.series.push_back(interval(series_start, now, series_torque_time, plan.power_scale));
+      result.largest_overlap_fraction =
+          std::max(result.largest_overlap_fraction, world.largest_overlap_fraction());
       if (measuring) {
         const auto [centre, angular_speed] = charge_motion(world.particles());
         result.charge_centre += centre;

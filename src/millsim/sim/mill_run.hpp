@@ -61,6 +61,10 @@ struct MillResult {
   /// The charge's angular speed about the mill axis (charge_motion) over the shell's, averaged
   /// over the window: 1 when the charge rides with the shell (centrifuged).
   double orbital_speed_ratio = 0.0;
+  /// The deepest overlap of any contact as a fraction of the smaller radius
+  /// (World::largest_overlap_fraction), the most at the end of settling and at each of the 50
+  /// samples a revolution while the shell turns.
+  double largest_overlap_fraction = 0.0;
   /// The liner layer's balls by angle over the measured window, and from them the charge's toe
   /// and shoulder (ChargeProfile; sampled 50 times a revolution, with the charge's centre).
   std::optional<ChargeProfile> charge_profile;

@@ -409,6 +409,29 @@ double World<D>::stored_spring_energy() const {
   return energy;
 }
 
+template <int D>
+double World<D>::largest_overlap_fraction() const {
+  double largest = 0.0;
+  const auto& touching = neighbours_.touching();
+  const auto& first = neighbours_.first();
+  const auto& second = neighbours_.second();
+  const auto& p = particles_;
+  for (std::size_t q = 0; q < touching.size(); ++q) {
+    if (touching[q] != TouchState::touching) continue;
+    const std::uint32_t i = first[q];
+    const std::uint32_t j = second[q];
+    const double overlap =
+        p.radius[i] + p.radius[j] - norm(neighbours_.separation(p.position[i], p.position[j]));
+    largest = std::max(largest, overlap / std::min(p.radius[i], p.radius[j]));
+  }
+  for (std::size_t s = 0; s < wall_slot_id_.size(); ++s) {
+    if (wall_slot_id_[s] < 0) continue;
+    const std::uint32_t i = wall_candidates_[s / max_wall_contacts];
+    largest = std::max(largest, wall_slot_history_[s].overlap / p.radius[i]);
+  }
+  return largest;
+}
+
 // Every member defined here or in world.hpp; the stages' members are instantiated in their
 // own files (world_pairs.cpp, world_walls.cpp, world_threads.cpp, world_integrate.cpp).
 template class World<2>;

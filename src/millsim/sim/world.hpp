@@ -231,6 +231,11 @@ class World {
   double kinetic_energy() const;        ///< translation and rotation, J
   double potential_energy() const;      ///< −Σ m g·x, J
   double stored_spring_energy() const;  ///< held by the springs of all current contacts, J
+  /// The deepest overlap of any current contact as a fraction of the smaller radius (of the
+  /// particle, against a wall): the pairs' at the positions now, the walls' as the last step
+  /// found them. A linear spring soft for its balls and speeds lets them sink into each other
+  /// and, past 1, through walls.
+  double largest_overlap_fraction() const;
 
  private:
   // The stages of step(), in order.
