@@ -198,6 +198,22 @@ TEST(SceneConfig, RefusesAnUnstableTimeStepAndGivesTheLimit) {
                   "for accuracy about 2.06e-05 s (1/20 of the contact), or \"auto\""});
 }
 
+TEST(SceneConfig, RefusesADurationShorterThanOneTimeStep) {
+  // The drop's auto step is 2.0599693e-5 s (AutoTimeStepIsATwentiethOfTheShortestContact): a
+  // scene of 1e-5 s would run one step, twice as long as asked.
+  std::string text(drop);
+  text.replace(text.find("time_step = 1e-6"), 16, "time_step = \"auto\"");
+  expect_refused(text, {"simulation.duration=1e-5"},
+                 {"command line (--set simulation.duration=1e-5): simulation.duration: 1e-05 s is "
+                  "shorter than one time step, 2.0599693",
+                  "(the auto step, 1/20 of the shortest contact: a smaller time_step gives a "
+                  "shorter one); allowed: a duration of at least one time step"});
+  expect_refused(drop, {"simulation.duration=5e-7"},
+                 {"simulation.duration: 5e-07 s is shorter than one time step, 1e-06 s "
+                  "(simulation.time_step)"});
+  EXPECT_EQ(millsim::plan_scene(scene(drop, {"simulation.duration=1e-6"})).steps, 1);
+}
+
 TEST(SceneConfig, RefusesAMillKeyInAScene) {
   expect_refused(std::string(drop) + "\n", {"simulation.settle_time=1"},
                  {"simulation.settle_time", "unknown key", "a mill key"});

@@ -192,6 +192,17 @@ ScenePlan plan_scene(const SceneConfig& config) {
         config.location_of("simulation.duration"), config.duration, plan.time_step, exact,
         most_steps));
   }
+  if (exact < 1.0) {
+    // One step would run past the end by more than the duration itself: two balls of 100 m at
+    // the auto step (11.4 s) ran 11.4 s of a 0.01 s scene.
+    throw InputError(fmt::format(
+        "{}: simulation.duration: {} s is shorter than one time step, {} s ({}); allowed: a "
+        "duration of at least one time step",
+        config.location_of("simulation.duration"), config.duration, plan.time_step,
+        config.time_step ? "simulation.time_step"
+                         : "the auto step, 1/20 of the shortest contact: a smaller time_step "
+                           "gives a shorter one"));
+  }
   const double whole = std::round(exact);
   plan.steps =
       static_cast<long>(std::abs(exact - whole) <= 1e-9 * exact ? whole : std::ceil(exact));
