@@ -480,6 +480,17 @@ TEST(Config, AValidOverrideChangesTheValueAndIsRecordedAsFromTheCommandLine) {
   EXPECT_EQ(c.location_of("charge.porosity"), std::string(file_name) + " (not given: its default)");
 }
 
+TEST(Config, SuggestsOnlyKeysThatAreLikelyMisspellings) {
+  // One edit in a short key, two from nine letters on; "young" is two edits from "count".
+  const std::string young = std::string(base_config) + "[materials.ball_ball]\nyoung = 1\n";
+  const std::string message = error_of(young);
+  expect_has(message, {"materials.ball_ball.young: unknown key"});
+  EXPECT_EQ(message.find("did you mean"), std::string::npos) << message;
+  expect_has(error_of(with(base_config, "filling", "filing = 0.3")), {"did you mean filling?"});
+  expect_has(error_of(with(base_config, "ball_diameter", "bal_diametr = 0.0508")),
+             {"did you mean ball_diameter?"});
+}
+
 TEST(Config, AnOverrideOfAnUnknownKeyNamesTheOption) {
   expect_has(error_of(base_config, {"mill.lifters.hieght=0.04"}),
              {"command line (--set mill.lifters.hieght=0.04)", "mill.lifters.hieght", "unknown key",
