@@ -480,6 +480,18 @@ TEST(Config, AValidOverrideChangesTheValueAndIsRecordedAsFromTheCommandLine) {
   EXPECT_EQ(c.location_of("charge.porosity"), std::string(file_name) + " (not given: its default)");
 }
 
+TEST(Config, RefusesATopSizeWhoseSmallestClassIsBelowATenthOfAMillimetre) {
+  // The graded charge's smallest class is 0.8³ = 0.512 of the top size.
+  const std::string text = with(base_config, "ball_diameter", "top_size = 0.0001");
+  expect_has(error_of(text),
+             {at_line(text, "top_size"), "charge.top_size: 0.0001 is not allowed",
+              "allowed: a number of metres from 0.0001953125 (whose smallest class, 0.512 of it, "
+              "is 0.1 mm)"});
+  const MillConfig least =
+      parse_mill_config(with(base_config, "ball_diameter", "top_size = 0.0001953125"), file_name);
+  for (const SizeClass& size : least.sizes) EXPECT_GE(size.diameter, 1e-4);
+}
+
 TEST(Config, SuggestsOnlyKeysThatAreLikelyMisspellings) {
   // One edit in a short key, two from nine letters on; "young" is two edits from "count".
   const std::string young = std::string(base_config) + "[materials.ball_ball]\nyoung = 1\n";

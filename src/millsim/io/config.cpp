@@ -276,7 +276,15 @@ void read_sizes(TableReader& section, MillConfig& config) {
     config.sizes = {{section.number("ball_diameter", std::nullopt, size_rule, fits), 1.0}};
     config.size_description = fmt::format("single size {} m", config.sizes[0].diameter);
   } else if (section.has("top_size")) {
-    const double top = section.number("top_size", std::nullopt, size_rule, fits);
+    // Its smallest class is 0.8³ = 0.512 of it (graded_charge), and at least 0.1 mm too.
+    constexpr double smallest_class = 0.512;
+    constexpr double least_top = 0.0001953125;  // 1e-4 / 0.512
+    const double top = section.number(
+        "top_size", std::nullopt,
+        fmt::format("a number of metres from {} (whose smallest class, {} of it, is 0.1 mm) to "
+                    "below {} (half the mill radius)",
+                    least_top, smallest_class, 0.5 * radius),
+        [&](double d) { return d >= least_top && d < 0.5 * radius; });
     config.sizes = graded_charge(top);
     config.size_description = fmt::format("graded, top size {} m (Bond equilibrium charge)", top);
   } else {
