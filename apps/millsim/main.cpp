@@ -406,6 +406,15 @@ int validate_command(const std::string& directory, const JobOptions& options) {
           "case, measured_power_kw, and optionally paper_power_kw and tolerance",
           path.string()));
     }
+    // The table's rows are named by case: two of one name could not be told apart.
+    for (std::size_t k = 0; k < plans.size(); ++k) {
+      if (plans[k].config.reference->case_name == config.reference->case_name) {
+        throw millsim::InputError(fmt::format(
+            "{}: [reference]: case = \"{}\" is the case of {} too; allowed: a name of its own "
+            "for each case",
+            config.location_of("reference.case"), config.reference->case_name, cases[k].string()));
+      }
+    }
     config.output_directory = (root / path.stem()).string();
     refuse_a_file_as_directory(config.output_directory, root_location);
     // What clearing the case's earlier results would refuse is refused before any case runs,

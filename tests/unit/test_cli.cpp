@@ -791,6 +791,17 @@ TEST_F(Cli, ValidateRefusesWhatWouldTakeTheNameOfItsTableBeforeAnyCaseRuns) {
       << named.err;
   EXPECT_FALSE(fs::exists(work_ / "runs"));
   fs::remove(work_ / "cases" / "validation.csv.toml");
+  // Two cases of one name, which the table could not tell apart.
+  fs::copy_file(work_ / "cases" / "a.toml", work_ / "cases" / "a2.toml");
+  const Outcome twice = millsim(std::string("validate cases -o runs ") + tiny_run);
+  EXPECT_EQ(twice.status, 2) << twice.err;
+  EXPECT_NE(twice.err.find("cases/a2.toml:"), std::string::npos) << twice.err;
+  EXPECT_NE(twice.err.find(": [reference]: case = \"a\" is the case of cases/a.toml too; "
+                           "allowed: a name of its own for each case"),
+            std::string::npos)
+      << twice.err;
+  EXPECT_FALSE(fs::exists(work_ / "runs"));
+  fs::remove(work_ / "cases" / "a2.toml");
   // Cases whose results would go to OUT itself ("..toml") or to its parent ("...toml"), where
   // clearing a run's earlier results would remove the user's snapshots/.
   fs::create_directories(work_ / "parent" / "snapshots");
