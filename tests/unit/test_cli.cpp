@@ -811,12 +811,12 @@ TEST_F(Cli, ValidateRefusesWhatWouldTakeTheNameOfItsTableBeforeAnyCaseRuns) {
     const Outcome dots = millsim(std::string("validate cases -o parent/runs ") + tiny_run);
     EXPECT_EQ(dots.status, 2) << name << ": " << dots.err;
     const std::string stem = name.substr(0, name.size() - 5);
-    EXPECT_NE(dots.err.find("cases/" + name + ": a case named \"" + stem +
-                            "\" would write its results to parent/runs/" + stem +
-                            ", outside parent/runs; allowed: a case file whose name without "
-                            ".toml is neither . nor .."),
-              std::string::npos)
-        << dots.err;
+    const std::string expected = fmt::format(
+        "cases/{}: a case named \"{}\" would write its results to parent/runs/{}, "
+        "outside parent/runs; allowed: a case file whose name without .toml is "
+        "neither . nor ..",
+        name, stem, stem);
+    EXPECT_NE(dots.err.find(expected), std::string::npos) << dots.err;
     EXPECT_FALSE(fs::exists(work_ / "parent" / "runs"));
     EXPECT_EQ(read_all(work_ / "parent" / "snapshots" / "notes.txt"), "kept\n");
     fs::remove(work_ / "cases" / name);
