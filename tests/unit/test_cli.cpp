@@ -255,9 +255,9 @@ TEST_F(Cli, RefusesLiftersThatOverlap) {
   const std::string text = with(base_config, "width", "width = 0.33");
   expect_refused(run_config(text),
                  {at_line(text, "width"), "mill.lifters.width", "0.33 is not allowed", "overlap"});
-  // The limit in full, 2π (0.45 − 0.04) / 8 m, not rounded to four digits (0.322).
+  // The limit, 2π (0.45 − 0.04) / 8 = 0.32201324699295 m, in six digits (below it).
   const std::string past_limit = with(base_config, "width", "width = 0.32202");
-  expect_refused(run_config(past_limit), {"0.32202 is not allowed", "> 0 and < 0.32201324699"});
+  expect_refused(run_config(past_limit), {"0.32202 is not allowed", "> 0 and < 0.322013 ("});
 }
 
 TEST_F(Cli, RefusesLiftersThatFillTheMill) {
@@ -292,6 +292,16 @@ TEST_F(Cli, RefusesASlabTooShortForItsBalls) {
            "speed = 0.5\nperiodic = true\nslab_length = 0.1");
   expect_refused(run_config(text), {at_line(text, "slab_length"), "mill.slab_length", "too short",
                                     "at least three largest ball diameters"});
+  // In a mill 0.15 m long no slab of 5.08 cm balls fits (three diameters are 0.1524 m): the
+  // message says so rather than allow a range with nothing in it.
+  const std::string none = with(text, "slab_length = 0.1", "slab_length = 0.15");
+  expect_refused(run_config(none),
+                 {"0.15 m is too short for balls of 0.0508 m",
+                  "three largest ball diameters, "
+                  "0.1524",
+                  "at most mill.length (0.15 m, shorter than that: no slab of these "
+                  "balls fits this mill; use smaller balls, a longer mill.length or a whole "
+                  "mill, mill.periodic = false)"});
 }
 
 TEST_F(Cli, InfoOfAConicalMillPrintsItsCones) {

@@ -310,11 +310,13 @@ TEST(MillPlan, RefusesMillsThatCannotRunNamingTheKey) {
   in_rpm.speed_fraction.reset();
   in_rpm.speed_rpm = 1e6;
   expect_has(plan_error(in_rpm),
-             {"mill.speed_rpm", "1000000 rpm is 21786.33", "at most 5 times critical, 229.501"});
-  // Just past the limit: in full, not rounded to "5 times" and "229.5 rpm", which it seemed to
-  // meet.
+             {"mill.speed_rpm", "1000000 rpm is 21786.332 times", "critical speed, 45.9003 rpm",
+              "at most 5 times critical, 229.50169 rpm"});
+  // Just past the limit: each figure to as many digits as keep it on its side of the limit,
+  // not "5 times" and "229.5 rpm", which the speed seemed to meet.
   in_rpm.speed_rpm = 229.502;
-  expect_has(plan_error(in_rpm), {"229.502 rpm is 5.0000", "at most 5 times critical, 229.501"});
+  expect_has(plan_error(in_rpm),
+             {"229.502 rpm is 5.00001 times", "at most 5 times critical, 229.50169 rpm"});
   // A 100 m mill 30 % full of 5 mm discs at a 2D void fraction of 0.2:
   // 0.3 × π 50² × 0.8 / (π/4 × 0.005²) = 9.6e7 discs.
   expect_has(plan_error(lab_mill({"mill.diameter=100", "charge.ball_diameter=0.005"})),

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <fmt/format.h>
+
+#include <charconv>
 #include <stdexcept>
 #include <string>
 
@@ -11,5 +14,22 @@ class InputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+/// Which side of a limit the allowed values lie on, for limit_text.
+enum class Allowed { above, below };
+
+/// A computed limit for a refusal's "allowed:" part, in the fewest significant digits from six
+/// that still lie on the allowed side of it, so that the message never seems to refuse a value
+/// it allows: 3 × 0.0508 = 0.15239999999999998 as a least slab length is "0.1524" (0.1524 is
+/// allowed), a cone's 0.16378660541979106 as a bound from above "0.1637866", not "0.1638".
+inline std::string limit_text(double limit, Allowed allowed) {
+  for (int digits = 6; digits < 17; ++digits) {
+    const std::string text = fmt::format("{:.{}g}", limit, digits);
+    double read = 0.0;
+    std::from_chars(text.data(), text.data() + text.size(), read);
+    if (allowed == Allowed::above ? read >= limit : read <= limit) return text;
+  }
+  return fmt::format("{}", limit);  // the shortest form that reads back as the limit itself
+}
 
 }  // namespace millsim

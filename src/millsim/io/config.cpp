@@ -162,7 +162,7 @@ void read_lifters(TableReader lifters, MillConfig& config) {
       "width", std::nullopt,
       fmt::format("a number of metres > 0 and < {} (wider, {} lifters {} m high would "
                   "overlap at their inner faces)",
-                  widest, config.lifter_count, config.lifter_height),
+                  limit_text(widest, Allowed::below), config.lifter_count, config.lifter_height),
       [&](double w) { return w > 0.0 && w < widest; });
 }
 
@@ -222,7 +222,7 @@ void read_cones(TableReader& section, MillConfig& config) {
       "cone_length", std::nullopt,
       fmt::format("a number of metres > 0 and < {} (longer, a cone at {} degrees from a mill "
                   "of {} m diameter would reach the axis)",
-                  longest, config.cone_angle_degrees, config.diameter),
+                  limit_text(longest, Allowed::below), config.cone_angle_degrees, config.diameter),
       [&](double l) { return l > 0.0 && l < longest; });
 }
 

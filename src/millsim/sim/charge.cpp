@@ -143,9 +143,10 @@ MillPlan plan_mill(const MillConfig& config) {
       throw InputError(
           fmt::format("{}: mill.speed_rpm: {} rpm is {} times this mill's critical speed, {} rpm; "
                       "allowed: > 0 and at most {} times critical, {} rpm (as for mill.speed)",
-                      config.location_of("mill.speed_rpm"), plan.speed_rpm, plan.speed_fraction,
-                      plan.critical_speed_rpm, most_speed_fraction,
-                      most_speed_fraction * plan.critical_speed_rpm));
+                      config.location_of("mill.speed_rpm"), plan.speed_rpm,
+                      limit_text(plan.speed_fraction, Allowed::above),
+                      fmt::format("{:.6g}", plan.critical_speed_rpm), most_speed_fraction,
+                      limit_text(most_speed_fraction * plan.critical_speed_rpm, Allowed::below)));
     }
   }
   plan.angular_speed = plan.speed_rpm * 2.0 * pi / 60.0;
@@ -153,11 +154,18 @@ MillPlan plan_mill(const MillConfig& config) {
 
   if (config.periodic && config.slab_length < 3.0 * plan.largest_ball) {
     // A ball must not meet two images of another across the period.
+    const double least = 3.0 * plan.largest_ball;
     throw InputError(fmt::format(
         "{}: mill.slab_length: {} m is too short for balls of {} m; allowed: at least three "
-        "largest ball diameters, {:.4g} m, and at most mill.length",
+        "largest ball diameters, {} m, and at most mill.length{}",
         config.location_of("mill.slab_length"), config.slab_length, plan.largest_ball,
-        3.0 * plan.largest_ball));
+        limit_text(least, Allowed::above),
+        least > config.length
+            ? fmt::format(" ({} m, shorter than that: no slab of these balls fits this mill; "
+                          "use smaller balls, a longer mill.length or a whole mill, "
+                          "mill.periodic = false)",
+                          config.length)
+            : std::string()));
   }
   if (config.dimension == 3 && !config.periodic && config.length < 1.1 * plan.largest_ball) {
     // Shorter, a ball could touch both ends at once, and the placement, which keeps each ball
