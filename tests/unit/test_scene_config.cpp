@@ -289,6 +289,17 @@ TEST(SceneConfig, RefusesAConfigWithoutParticlesOrMill) {
                   "velocity, angular_velocity, density, material"});
 }
 
+TEST(SceneConfig, AConfigOfNeitherKindNamesAnUnknownTopLevelTableFirst) {
+  // "[[particle]]" for "[[particles]]": the config is then neither a mill nor a scene, and the
+  // misspelt table, with its line, is what to say, not only that [mill] is missing.
+  expect_refused("[simulation]\nduration = 1\n[[particle]]\nposition = [0, 0]\n", {},
+                 {"drop.toml:3: particle: unknown table (did you mean particles?), and the config "
+                  "has neither [mill] nor [[particles]]; allowed at the top level: simulation, "
+                  "mill, charge, materials, output, reference, particles, walls"});
+  expect_refused("[simulation]\nduration = 1\n", {"particle.x=1"},
+                 {"command line (--set particle.x=1): particle: unknown table"});
+}
+
 TEST(SceneConfig, AMillCommandRefusesASceneClearly) {
   try {
     millsim::parse_mill_config(drop, "drop.toml");

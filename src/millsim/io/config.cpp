@@ -1,6 +1,7 @@
 #include "millsim/io/config.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -569,7 +570,22 @@ JobConfig parse_config(std::string_view toml_text, const std::string& source,
     return read_scene_config(document, source);
   }
   if (is_scene(document)) {
-    // Neither kind: say so before any key of [simulation] is judged by the wrong kind's rules.
+    // Neither kind: say so before any key of [simulation] is judged by the wrong kind's rules,
+    // naming first a top-level name that neither kind has ("[[particle]]" for "[[particles]]").
+    static constexpr std::string_view top_level[] = {
+        "simulation", "mill", "charge", "materials", "output", "reference", "particles", "walls"};
+    for (const auto& [key, node] : document) {
+      if (std::find(std::begin(top_level), std::end(top_level), key.str()) != std::end(top_level)) {
+        continue;
+      }
+      const auto near = closest_key(key.str(), top_level);
+      throw InputError(fmt::format(
+          "{}: {}: unknown table{}, and the config has neither [mill] nor [[particles]]; "
+          "allowed at the top level: {}",
+          source_location(node, source), key.str(),
+          near ? fmt::format(" (did you mean {}?)", *near) : std::string(),
+          fmt::join(top_level, ", ")));
+    }
     throw InputError(fmt::format(
         "{}: mill: missing required table [mill], and no [[particles]] either; allowed: a mill "
         "(a table [mill] with diameter, length and speed or speed_rpm, and [charge]) or a scene "
