@@ -24,7 +24,7 @@ enum class Allowed { above, below };
 /// allowed), a cone's 0.16378660541979106 as a bound from above "0.1637866", not "0.1638".
 inline std::string limit_text(double limit, Allowed allowed) {
   for (int digits = 6; digits < 17; ++digits) {
-    const std::string text = fmt::format("{:.{}g}", limit, digits);
+    std::string text = fmt::format("{:.{}g}", limit, digits);
     double read = 0.0;
     std::from_chars(text.data(), text.data() + text.size(), read);
     if (allowed == Allowed::above ? read >= limit : read <= limit) return text;
