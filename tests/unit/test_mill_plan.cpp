@@ -327,6 +327,9 @@ TEST(MillPlan, RefusesMillsThatCannotRunNamingTheKey) {
   // 2.6143604 s: 17.013 s, at 1e-9 s a step 1.70e10 steps.
   expect_has(plan_error(lab_mill({"simulation.time_step=1e-9"})),
              {"simulation.revolutions", "1.7e+10 steps", "at most 1e+10 steps"});
+  // A subnormal step overflows the count, which once read "inf steps".
+  expect_has(plan_error(lab_mill({"simulation.time_step=1e-310"})),
+             {"simulation.revolutions", "is more than 1.8e+308 steps", "at most 1e+10 steps"});
   MillConfig snapshots = lab_mill();
   snapshots.snapshot_interval = 1e-5;
   expect_has(plan_error(snapshots),

@@ -214,6 +214,16 @@ TEST(SceneConfig, RefusesADurationShorterThanOneTimeStep) {
   EXPECT_EQ(millsim::plan_scene(scene(drop, {"simulation.duration=1e-6"})).steps, 1);
 }
 
+TEST(SceneConfig, RefusesTooManyStepsWithACountThatReads) {
+  // 0.01 s in steps of 1e-13 s: 1e11 steps, ten times the most a scene runs.
+  expect_refused(drop, {"simulation.time_step=1e-13"},
+                 {"simulation.duration: 0.01 s at a time step of 1e-13 s is 1e+11 steps; "
+                  "allowed: at most 1e+10 steps"});
+  // A subnormal step: 0.01 / 1e-320 overflows, and once read "inf steps".
+  expect_refused(drop, {"simulation.time_step=1e-320"},
+                 {"is more than 1.8e+308 steps; allowed: at most 1e+10 steps"});
+}
+
 TEST(SceneConfig, RefusesAMillKeyInAScene) {
   expect_refused(std::string(drop) + "\n", {"simulation.settle_time=1"},
                  {"simulation.settle_time", "unknown key", "a mill key"});

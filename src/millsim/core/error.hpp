@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <charconv>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -30,6 +31,13 @@ inline std::string limit_text(double limit, Allowed allowed) {
     if (allowed == Allowed::above ? read >= limit : read <= limit) return text;
   }
   return fmt::format("{}", limit);  // the shortest form that reads back as the limit itself
+}
+
+/// A count of time steps computed from the user's values, for a refusal: "1.7e+13", or "more
+/// than 1.8e+308" when it overflowed (a time step of 1e-310 s gave "inf steps").
+inline std::string step_count_text(double count) {
+  if (std::isfinite(count)) return fmt::format("{:.3g}", count);
+  return "more than 1.8e+308";
 }
 
 }  // namespace millsim

@@ -296,11 +296,11 @@ MillPlan plan_mill(const MillConfig& config) {
   if (!(steps <= most_steps)) {
     throw InputError(fmt::format(
         "{}: simulation.revolutions: {} s of settling, the spin-up and {} revolutions of {:.4g} "
-        "s at a time step of {:.4g} s is {:.3g} steps; allowed: at most {:.0e} steps (fewer "
+        "s at a time step of {:.4g} s is {} steps; allowed: at most {:.0e} steps (fewer "
         "revolutions, a shorter settle_time, a faster mill.speed, or a longer "
         "simulation.time_step)",
         config.location_of("simulation.revolutions"), config.settle_time, config.revolutions,
-        plan.revolution_period, plan.time_step, steps, most_steps));
+        plan.revolution_period, plan.time_step, step_count_text(steps), most_steps));
   }
   if (config.snapshot_interval > 0.0 && config.snapshot_interval < plan.time_step) {
     throw InputError(fmt::format(

@@ -187,10 +187,10 @@ ScenePlan plan_scene(const SceneConfig& config) {
   constexpr double most_steps = 1e10;
   if (!(exact <= most_steps)) {
     throw InputError(fmt::format(
-        "{}: simulation.duration: {} s at a time step of {:.4g} s is {:.3g} steps; allowed: at "
+        "{}: simulation.duration: {} s at a time step of {:.4g} s is {} steps; allowed: at "
         "most {:.0e} steps (shorten the duration or lengthen the time step)",
-        config.location_of("simulation.duration"), config.duration, plan.time_step, exact,
-        most_steps));
+        config.location_of("simulation.duration"), config.duration, plan.time_step,
+        step_count_text(exact), most_steps));
   }
   if (exact < 1.0) {
     // One step would run past the end by more than the duration itself: two balls of 100 m at
