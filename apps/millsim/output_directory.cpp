@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <limits.h>
 #include <stdlib.h>
 #include <unistd.h>
 
@@ -37,6 +38,36 @@ void refuse_a_file_as_directory(const fs::path& out, const std::string& location
 }
 
 namespace {
+
+/// The longest file a run writes in snapshots/: a snapshot's .partial with ten digits, since a
+/// run takes at most 1e10 steps and so writes fewer than 1e10 snapshots.
+constexpr std::string_view longest_snapshot_file = "snapshots/snapshot_0000000000.csv.partial";
+
+/// Refuses an output directory whose path leaves no room for the longest path the run makes in
+/// it: the directory the earlier results are moved aside into, a result's NAME.partial, or a
+/// snapshot's. Without this, a path just under the system's limit passed every check and the run
+/// failed at its first snapshot, after the charge had settled. (An earlier result moved aside is
+/// one level deeper still: a rename that cannot be made is a refusal that loses nothing.)
+void refuse_a_path_too_long(const fs::path& out, const std::string& location,
+                            std::initializer_list<const char*> results, Snapshots snapshots) {
+  std::string longest = std::string(aside_prefix) + "XXXXXX";
+  for (const char* name : results) {
+    std::string partial = std::string(name) + ".partial";
+    if (partial.size() > longest.size()) longest = std::move(partial);
+  }
+  if (snapshots == Snapshots::made && longest_snapshot_file.size() > longest.size()) {
+    longest = longest_snapshot_file;
+  }
+  constexpr std::size_t most = PATH_MAX - 1;  // the system's limit, the terminating zero aside
+  const std::size_t written = (out / longest).string().size();
+  if (written <= most) return;
+  throw millsim::InputError(fmt::format(
+      "{}: output.directory: a path of {} characters leaves no room for the files the run "
+      "writes in it (its {} would be a path of {}); allowed: a directory path of at most {} "
+      "characters (the system takes paths of at most {})",
+      location, out.string().size(), longest, written, most - (written - out.string().size()),
+      most));
+}
 
 /// Makes `out` (and its missing parents) and writes and removes a file of its own in it, so
 /// that a directory that exists but takes no files (read-only, full, immutable) is found now,
@@ -123,6 +154,7 @@ void refuse_a_taken_name(const fs::path& out, const std::string& location,
 
 void check_output_directory(const fs::path& out, const std::string& location,
                             std::initializer_list<const char*> results, Snapshots snapshots) {
+  refuse_a_path_too_long(out, location, results, snapshots);
   refuse_a_file_as_directory(out, location);
   std::error_code error;
   if (fs::symlink_status(out, error).type() == fs::file_type::not_found) return;
@@ -134,6 +166,7 @@ void check_output_directory(const fs::path& out, const std::string& location,
 
 EarlierResults move_results_aside(const fs::path& out, const std::string& location,
                                   std::initializer_list<const char*> results, Snapshots snapshots) {
+  refuse_a_path_too_long(out, location, results, snapshots);
   refuse_a_file_as_directory(out, location);
   make_and_check_writable(out, location);
   std::vector<std::string> names = result_names(results, snapshots);

@@ -612,6 +612,34 @@ TEST_F(Cli, AResultThatCannotBeMovedAsideRefusesTheRunAndPutsBackThoseThatWere) 
   }
 }
 
+TEST_F(Cli, AnOutputPathWithNoRoomForTheSnapshotsIsRefusedBeforeTheRun) {
+  // 4060 characters: room for out/power_timeseries.csv.partial (4089 of the system's 4095), none
+  // for out/snapshots/snapshot_0000000000.csv.partial (4102). Such a run once settled its charge
+  // and then failed at its first snapshot (exit 1).
+  write_config(base_config);
+  std::string out(200, 'a');
+  for (int k = 1; k < 19; ++k) out += "/" + std::string(200, 'a');
+  out += "/" + std::string(241, 'b');
+  ASSERT_EQ(out.size(), 4060U);
+  const std::string short_run =
+      " --set simulation.revolutions=1 --set simulation.measure_revolutions=1 "
+      "--set simulation.settle_time=0.01 --set output.snapshot_interval=";
+  const Outcome o = millsim("run mill.toml -q -o " + out + short_run + "0.05");
+  EXPECT_EQ(o.status, 2) << o.err;
+  EXPECT_NE(o.err.find("): output.directory: a path of 4060 characters leaves no room for the "
+                       "files the run writes in it (its snapshots/snapshot_0000000000.csv.partial "
+                       "would be a path of 4102); allowed: a directory path of at most 4053 "
+                       "characters (the system takes paths of at most 4095)"),
+            std::string::npos)
+      << o.err;
+  EXPECT_FALSE(fs::exists(work_ / std::string(200, 'a'))) << "nothing is made";
+  // Without snapshots the same directory has room for every result.
+  // (work_ / out is beyond the system's limit: the test reads it through the program's output.)
+  const Outcome without = millsim("run mill.toml -q -o " + out + short_run + "0");
+  EXPECT_EQ(without.status, 0) << without.err;
+  EXPECT_TRUE(without.out.starts_with("power ")) << without.out;
+}
+
 TEST_F(Cli, AnUnknownCommandIsNamed) {
   const Outcome o = millsim("frobnicate mill.toml");
   EXPECT_EQ(o.status, 2) << o.err;
