@@ -310,6 +310,21 @@ TEST(SceneConfig, AConfigOfNeitherKindNamesAnUnknownTopLevelTableFirst) {
                  {"command line (--set particle.x=1): particle: unknown table"});
 }
 
+TEST(SceneConfig, AConfigOfNeitherKindNamesAnUnknownSimulationKeyNext) {
+  // "particles = 5" under [simulation] (a count where a scene lists its particles): named with
+  // its line, not only that [mill] is missing.
+  expect_refused("[simulation]\ndimension = 2\nparticles = 5\n", {},
+                 {"drop.toml:3: simulation.particles: unknown key, and the config has neither "
+                  "[mill] nor [[particles]]; allowed in [simulation]: dimension, time_step, "
+                  "settle_time, revolutions, measure_revolutions, seed (a mill) or dimension, "
+                  "time_step, duration, gravity (a scene)"});
+  expect_refused("[simulation]\nduraton = 1\n", {},
+                 {"drop.toml:2: simulation.duraton: unknown key (did you mean duration?)"});
+  // Every key known to one kind or the other: the missing [mill] is what to say.
+  expect_refused("[simulation]\nduration = 1\nseed = 3\n", {},
+                 {"drop.toml: mill: missing required table [mill], and no [[particles]] either"});
+}
+
 TEST(SceneConfig, AMillCommandRefusesASceneClearly) {
   try {
     millsim::parse_mill_config(drop, "drop.toml");

@@ -12,8 +12,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
+#include <span>
 #include <sstream>
+#include <string_view>
 #include <utility>
+#include <vector>
 
 #include "millsim/core/constants.hpp"
 #include "millsim/core/error.hpp"
@@ -42,7 +46,7 @@ struct KnownTable {
 const std::vector<KnownTable>& known_tables() {
   static const std::vector<KnownTable> tables = {
       {"simulation",
-       {"dimension", "time_step", "settle_time", "revolutions", "measure_revolutions", "seed"}},
+       {config_detail::mill_simulation_keys.begin(), config_detail::mill_simulation_keys.end()}},
       {"mill",
        {"diameter", "length", "speed", "speed_rpm", "periodic", "slab_length", "cone_angle",
         "cone_length", "lifters"}},
@@ -94,9 +98,7 @@ std::optional<double> read_time_step(TableReader& section) {
 namespace {
 
 void read_simulation(TableReader section, MillConfig& config) {
-  section.allow_keys(
-      {"dimension", "time_step", "settle_time", "revolutions", "measure_revolutions", "seed"},
-      belongs_elsewhere);
+  section.allow_keys(config_detail::mill_simulation_keys, belongs_elsewhere);
   config.dimension =
       static_cast<int>(section.integer("dimension", 2, "2 (a slice of discs) or 3 (spheres)",
                                        [](long d) { return d == 2 || d == 3; }));
@@ -475,13 +477,12 @@ MillConfig read_mill_config(const toml::table& document, const std::string& sour
   MillConfig config;
   config.source = source;
   TableReader root(document, "", source, &config.key_locations);
-  root.allow_keys({"simulation", "mill", "charge", "materials", "output", "reference"},
-                  [](std::string_view key) -> std::string {
-                    if (key == "particles" || key == "walls") {
-                      return "a scene's table; a scene config has no [mill]";
-                    }
-                    return belongs_elsewhere(key);
-                  });
+  root.allow_keys(config_detail::mill_tables, [](std::string_view key) -> std::string {
+    if (key == "particles" || key == "walls") {
+      return "a scene's table; a scene config has no [mill]";
+    }
+    return belongs_elsewhere(key);
+  });
   read_simulation(root.table("simulation", false), config);
   read_mill(root.table("mill", true,
                        "a table [mill] with diameter, length and speed or speed_rpm "
@@ -540,6 +541,27 @@ std::string read_config_file(const std::string& path) {
   return text.str();
 }
 
+/// The names of `mill`, then those of `scene` that `mill` does not have.
+std::vector<std::string_view> either_kind(std::span<const std::string_view> mill,
+                                          std::span<const std::string_view> scene) {
+  std::vector<std::string_view> names(mill.begin(), mill.end());
+  for (const std::string_view name : scene) {
+    if (std::find(mill.begin(), mill.end(), name) == mill.end()) names.push_back(name);
+  }
+  return names;
+}
+
+/// The first key of `table` not among `names`, with its node.
+std::optional<std::pair<std::string, const toml::node*>> first_unknown(
+    const toml::table& table, std::span<const std::string_view> names) {
+  for (const auto& [key, node] : table) {
+    if (std::find(names.begin(), names.end(), key.str()) == names.end()) {
+      return std::pair<std::string, const toml::node*>(std::string(key.str()), &node);
+    }
+  }
+  return std::nullopt;
+}
+
 bool is_scene(const toml::table& document) {
   return !document.contains("mill");
 }
@@ -572,19 +594,32 @@ JobConfig parse_config(std::string_view toml_text, const std::string& source,
   if (is_scene(document)) {
     // Neither kind: say so before any key of [simulation] is judged by the wrong kind's rules,
     // naming first a top-level name that neither kind has ("[[particle]]" for "[[particles]]").
-    static constexpr std::string_view top_level[] = {
-        "simulation", "mill", "charge", "materials", "output", "reference", "particles", "walls"};
-    for (const auto& [key, node] : document) {
-      if (std::find(std::begin(top_level), std::end(top_level), key.str()) != std::end(top_level)) {
-        continue;
-      }
-      const auto near = closest_key(key.str(), top_level);
+    using config_detail::mill_simulation_keys;
+    using config_detail::scene_simulation_keys;
+    const std::vector<std::string_view> tables =
+        either_kind(config_detail::mill_tables, config_detail::scene_tables);
+    if (const auto unknown = first_unknown(document, tables)) {
+      const auto near = closest_key(unknown->first, tables);
       throw InputError(fmt::format(
           "{}: {}: unknown table{}, and the config has neither [mill] nor [[particles]]; "
           "allowed at the top level: {}",
-          source_location(node, source), key.str(),
+          source_location(*unknown->second, source), unknown->first,
           near ? fmt::format(" (did you mean {}?)", *near) : std::string(),
-          fmt::join(top_level, ", ")));
+          fmt::join(tables, ", ")));
+    }
+    // Then a [simulation] key that neither kind has ("particles = 5"), with its line: a user
+    // who added [mill] would be told of it next.
+    const std::vector<std::string_view> keys =
+        either_kind(mill_simulation_keys, scene_simulation_keys);
+    const toml::table* simulation = document["simulation"].as_table();
+    if (const auto unknown = simulation ? first_unknown(*simulation, keys) : std::nullopt) {
+      const auto near = closest_key(unknown->first, keys);
+      throw InputError(fmt::format(
+          "{}: simulation.{}: unknown key{}, and the config has neither [mill] nor "
+          "[[particles]]; allowed in [simulation]: {} (a mill) or {} (a scene)",
+          source_location(*unknown->second, source), unknown->first,
+          near ? fmt::format(" (did you mean {}?)", *near) : std::string(),
+          fmt::join(mill_simulation_keys, ", "), fmt::join(scene_simulation_keys, ", ")));
     }
     throw InputError(fmt::format(
         "{}: mill: missing required table [mill], and no [[particles]] either; allowed: a mill "

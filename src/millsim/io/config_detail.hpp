@@ -5,14 +5,27 @@
 
 #include <toml++/toml.h>
 
+#include <array>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "millsim/io/config.hpp"
 #include "millsim/io/toml_reader.hpp"
 #include "millsim/particles/material.hpp"
 
 namespace millsim::config_detail {
+
+/// The names a mill config and a scene config allow at the top level and in [simulation]: what
+/// each reader allows, and what a config of neither kind is checked against.
+inline constexpr std::array<std::string_view, 6> mill_tables = {
+    "simulation", "mill", "charge", "materials", "output", "reference"};
+inline constexpr std::array<std::string_view, 5> scene_tables = {"simulation", "particles", "walls",
+                                                                 "materials", "output"};
+inline constexpr std::array<std::string_view, 6> mill_simulation_keys = {
+    "dimension", "time_step", "settle_time", "revolutions", "measure_revolutions", "seed"};
+inline constexpr std::array<std::string_view, 4> scene_simulation_keys = {"dimension", "time_step",
+                                                                          "duration", "gravity"};
 
 /// simulation.time_step: "auto" (empty) or a number of seconds > 0.
 std::optional<double> read_time_step(TableReader& section);

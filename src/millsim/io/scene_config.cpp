@@ -62,7 +62,7 @@ std::array<double, 3> read_vector(TableReader& table, std::string_view key, int 
 }
 
 void read_scene_simulation(TableReader section, SceneConfig& config) {
-  section.allow_keys({"dimension", "time_step", "duration", "gravity"}, scene_hint);
+  section.allow_keys(scene_simulation_keys, scene_hint);
   config.dimension = static_cast<int>(section.integer("dimension", 2, "2 (discs) or 3 (spheres)",
                                                       [](long d) { return d == 2 || d == 3; }));
   config.time_step = read_time_step(section);
@@ -228,13 +228,12 @@ SceneConfig read_scene_config(const toml::table& document, const std::string& so
   SceneConfig config;
   config.source = source;
   TableReader root(document, "", source, &config.key_locations);
-  root.allow_keys({"simulation", "particles", "walls", "materials", "output"},
-                  [](std::string_view key) -> std::string {
-                    if (key == "charge" || key == "reference") {
-                      return "a mill table; this config has no [mill], so it is a scene";
-                    }
-                    return {};
-                  });
+  root.allow_keys(scene_tables, [](std::string_view key) -> std::string {
+    if (key == "charge" || key == "reference") {
+      return "a mill table; this config has no [mill], so it is a scene";
+    }
+    return {};
+  });
   read_scene_simulation(root.table("simulation", true,
                                    "a table [simulation] with duration (and dimension, "
                                    "time_step, gravity)"),

@@ -299,7 +299,7 @@ std::string TableReader::table_name() const {
   return fmt::format("[{}]", path_);
 }
 
-void TableReader::allow_keys(std::initializer_list<std::string_view> keys,
+void TableReader::allow_keys(std::span<const std::string_view> keys,
                              const std::function<std::string(std::string_view)>& hint) {
   std::string list;
   for (const std::string_view k : keys)

@@ -54,8 +54,12 @@ class TableReader {
   /// Declares the keys this table may hold and refuses any other at once, suggesting the
   /// closest allowed key. `hint`, when given, may return a remark for an unknown key that has
   /// no close match (e.g. "it belongs in [charge]"); an empty string means none.
-  void allow_keys(std::initializer_list<std::string_view> keys,
+  void allow_keys(std::span<const std::string_view> keys,
                   const std::function<std::string(std::string_view)>& hint = {});
+  void allow_keys(std::initializer_list<std::string_view> keys,
+                  const std::function<std::string(std::string_view)>& hint = {}) {
+    allow_keys(std::span<const std::string_view>(keys.begin(), keys.size()), hint);
+  }
 
   bool has(std::string_view key) const;
   /// The value of `key`, nullptr if absent; records where it was given in `locations`.
