@@ -246,6 +246,17 @@ TEST(Mill, EnergyAccountClosesAndBothPowersAgree) {
   const MillResult r =
       run(lab_mill({"simulation.revolutions=4", "simulation.measure_revolutions=3"}));
   testing::expect_energy_account_closes(r);
+  // The power reported is the slice's, scaled to the mill by charge mass (MODEL.md §2): the
+  // slice's shell work over the window times ρ (1 − porosity) J π R² L / Σ m_disc = 3.3364732
+  // for this mill (MillPlan.DiscCountMassesAndPowerScaleOfOneSize works it by hand).
+  const double slice_watts = (r.window_end.shell_work - r.window_start.shell_work) /
+                             (r.window_end.time - r.window_start.time);
+  EXPECT_GT(slice_watts, 0.0);
+  EXPECT_NEAR(r.power_kw, 3.3364732 * slice_watts / 1000.0, 1e-7 * r.power_kw);
+  const double slice_dissipation = (r.window_end.dissipated - r.window_start.dissipated) /
+                                   (r.window_end.time - r.window_start.time);
+  EXPECT_NEAR(r.power_dissipation_kw, 3.3364732 * slice_dissipation / 1000.0,
+              1e-7 * r.power_dissipation_kw);
   // With ω steady over the window, the mean torque times ω is the power.
   EXPECT_NEAR(r.torque_nm * r.plan.angular_speed / 1000.0, r.power_kw, 1e-9 * r.power_kw);
   // The run lasts as long as its plan says (what `info` and the progress line report), spin-up

@@ -86,11 +86,18 @@ void check_break_forgets_both_springs() {
   // at 5 m/s along y. Each step the tangential spring grows by −k_s v_s Δt = −8e5 × 5 × 1e-5
   // = −40 N along y: −80 N after the second, when the normal spring is k_n δ = 100 N. The
   // contact sticks: the trial force −80 − c_s v_s = −85 N is below μ (100 + c_n × 5) = 150 N.
-  law.evaluate(moving<D>(5e-5, -speed, speed), damping, history, time_step);
-  law.evaluate(moving<D>(1e-4, -speed, speed), damping, history, time_step);
+  // Each sticking step books both dashpots' work (MODEL.md §7), |D_n·v_n| Δt + |D_s·v_s| Δt =
+  // c_n v_n² Δt + c_s v_s² Δt = (40 × 25 + 1 × 25) × 10⁻⁵ = 1.025 × 10⁻² J, and no slip work.
+  const ContactOutput<D> first =
+      law.evaluate(moving<D>(5e-5, -speed, speed), damping, history, time_step);
+  expect_close(first.dissipated, 1.025e-2);
+  const ContactOutput<D> second =
+      law.evaluate(moving<D>(1e-4, -speed, speed), damping, history, time_step);
+  expect_close(second.dissipated, 1.025e-2);
   ASSERT_EQ(history.normal_spring_origin, 0.0);
   expect_close(tangential_spring_force(history), -80.0 * y);
   const double dissipated_before = history.dissipated;
+  expect_close(dissipated_before, 2.05e-2);
 
   // Separating at 5 m/s, the overlap back at 5 × 10⁻⁵ m: the normal spring pushes k_n δ = 50 N,
   // the dashpot pulls c_n × 5 = 200 N, so the total −150 N would pull: the contact breaks.
