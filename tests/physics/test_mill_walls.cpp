@@ -12,6 +12,7 @@
 #include "millsim/core/constants.hpp"
 #include "millsim/geometry/walls.hpp"
 #include "millsim/io/config.hpp"
+#include "millsim/measure/spectrum.hpp"
 #include "millsim/sim/charge.hpp"
 #include "millsim/sim/world.hpp"
 
@@ -340,6 +341,45 @@ TEST(MillWall, ADiscDroppedInAStillShellFirstStrikesItWhereItFalls) {
     const double expected = std::atan2(-std::sqrt(reach * reach - x0 * x0), x0);
     EXPECT_EQ(impacts.count(ContactType::ball_shell, impacts.bin_of(expected)), 1)
         << "expected at " << expected * 180.0 / pi << " degrees";
+  }
+}
+
+TEST(MillWall, ADiscDroppedOnALifterIsABallLifterCollisionAndBesideItABallShellOne) {
+  // The lab mill's lifters, still, lifter 0 pointing straight down (its inner face at
+  // y = −0.41 m). A disc let go above it at x = 0 lands on that face; one let go at x = 0.2 m
+  // falls to the shell at 62° below the horizontal, 17° from the nearest lifter (at −45°; 0.12 m
+  // of arc against the 0.045 m a disc needs to touch its side). Each first impact is recorded in
+  // the spectrum as its own contact type, with the energy it lost: less than the fall gave it
+  // (from y = 0.1 m to contact: m g 0.4846 and m g 0.4746), more than a tenth of it.
+  for (const double x0 : {0.0, 0.2}) {
+    SCOPED_TRACE(x0);
+    WorldSettings<2> settings;
+    settings.time_step = time_step;
+    settings.gravity = Vec2{{0.0, -standard_gravity}};
+    settings.ball_ball = steel;
+    settings.ball_wall = steel;
+    Walls<2> walls;
+    walls.mill = lab_mill_walls(-0.5 * pi, 0.0);
+    World<2> world(settings, walls);
+    world.particles().add(Vec2{{x0, 0.1}}, ball_radius, ball_mass);
+    ImpactSpectrum spectrum;
+    world.record_collisions_in(&spectrum);
+    const auto impacts = [&] {
+      return spectrum.total_count(ContactType::ball_lifter) +
+             spectrum.total_count(ContactType::ball_shell);
+    };
+    for (long n = 0; n < 20000 && impacts() == 0; ++n) world.step();
+    const ContactType hit = x0 == 0.0 ? ContactType::ball_lifter : ContactType::ball_shell;
+    const ContactType other = x0 == 0.0 ? ContactType::ball_shell : ContactType::ball_lifter;
+    ASSERT_EQ(spectrum.total_count(hit), 1);
+    EXPECT_EQ(spectrum.total_count(other), 0);
+    const double fall =
+        x0 == 0.0 ? 0.1 + inner_face - ball_radius
+                  : 0.1 + std::sqrt((shell_radius - ball_radius) * (shell_radius - ball_radius) -
+                                    x0 * x0);
+    const double energy = spectrum.total_energy(hit);
+    EXPECT_GT(energy, 0.1 * ball_mass * standard_gravity * fall);
+    EXPECT_LT(energy, ball_mass * standard_gravity * fall);
   }
 }
 
