@@ -169,5 +169,32 @@ TEST(ContactSlip, ASlippingStepIsCappedAtMuTimesTheTotalNormalForceSpheres) {
   check_slipping_step<3>();
 }
 
+// MODEL.md §3: the stored tangential spring is carried round as the contact normal turns,
+// keeping its length (R of F_s ← R(F_s) − k_s v_s Δt). In 2D the spring is a signed length
+// along the tangent t = (n_y, −n_x) (docs/model.md), so R is the exact rotation with the normal.
+// Two sticking steps along n = x build −80 N along y (as in ContactBreak); then the pair turns
+// by φ = 30° while still approaching at 5 m/s with no sliding: the normal spring grows to 150 N,
+// the total normal force is 150 + c_n × 5 = 350 N, and the spring, below μ × 350 = 175 N, is the
+// same 80 N turned with the normal: 80 t = 80 (sin φ, −cos φ).
+TEST(ContactSpring2D, TurnsWithTheNormalKeepingItsLength) {
+  const LinearSpringDashpot law = test_law();
+  ContactHistory<2> history;
+  law.evaluate(moving<2>(5e-5, -speed, speed), damping, history, time_step);
+  law.evaluate(moving<2>(1e-4, -speed, speed), damping, history, time_step);
+  expect_close(tangential_spring_force(history), Vec2{{0.0, -80.0}});
+  const double phi = std::acos(-1.0) / 6.0;
+  const Vec2 n{{std::cos(phi), std::sin(phi)}};
+  ContactInput<2> in;
+  in.normal = n;
+  in.overlap = 1.5e-4;
+  in.velocity = -speed * n;
+  in.step_velocity = in.velocity;
+  const ContactOutput<2> turned = law.evaluate(in, damping, history, time_step);
+  const Vec2 spring{{80.0 * std::sin(phi), -80.0 * std::cos(phi)}};
+  expect_close(turned.force, 350.0 * n + spring);
+  expect_close(turned.tangential_force, spring);
+  EXPECT_NEAR(std::abs(history.tangential_spring), 80.0, 1e-12 * 80.0);
+}
+
 }  // namespace
 }  // namespace millsim
