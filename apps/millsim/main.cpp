@@ -707,7 +707,14 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
     current.insert(rows[i].directory);
   }
   // Everything the clearing below would refuse is refused first, so that a refusal clears
-  // nothing: the earlier points', this sweep's points' and the table's names.
+  // nothing: the earlier points', this sweep's points' and the table's names. A point's
+  // directory too long for its files is refused now too, whether it is there yet or not (each
+  // point is checked again as it starts, when that would fail it after others had run).
+  for (const MillPlan& plan : plans) {
+    millsim_app::refuse_a_path_too_long(
+        plan.config.output_directory, root_location, mill_result_names,
+        plan.config.snapshot_interval > 0.0 ? Snapshots::made : Snapshots::removed);
+  }
   std::vector<std::string> stale;
   for (const std::string& name : earlier_point_directories(root)) {
     if (current.contains(name) || std::find(stale.begin(), stale.end(), name) != stale.end()) {

@@ -37,17 +37,10 @@ void refuse_a_file_as_directory(const fs::path& out, const std::string& location
   }
 }
 
-namespace {
-
 /// The longest file a run writes in snapshots/: a snapshot's .partial with ten digits, since a
 /// run takes at most 1e10 steps and so writes fewer than 1e10 snapshots.
 constexpr std::string_view longest_snapshot_file = "snapshots/snapshot_0000000000.csv.partial";
 
-/// Refuses an output directory whose path leaves no room for the longest path the run makes in
-/// it: the directory the earlier results are moved aside into, a result's NAME.partial, or a
-/// snapshot's. Without this, a path just under the system's limit passed every check and the run
-/// failed at its first snapshot, after the charge had settled. (An earlier result moved aside is
-/// one level deeper still: a rename that cannot be made is a refusal that loses nothing.)
 void refuse_a_path_too_long(const fs::path& out, const std::string& location,
                             std::initializer_list<const char*> results, Snapshots snapshots) {
   std::string longest = std::string(aside_prefix) + "XXXXXX";
@@ -68,6 +61,8 @@ void refuse_a_path_too_long(const fs::path& out, const std::string& location,
       location, out.string().size(), longest, written, most - (written - out.string().size()),
       most));
 }
+
+namespace {
 
 /// Makes `out` (and its missing parents) and writes and removes a file of its own in it, so
 /// that a directory that exists but takes no files (read-only, full, immutable) is found now,

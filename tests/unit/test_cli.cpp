@@ -640,6 +640,29 @@ TEST_F(Cli, AnOutputPathWithNoRoomForTheSnapshotsIsRefusedBeforeTheRun) {
   EXPECT_TRUE(without.out.starts_with("power ")) << without.out;
 }
 
+TEST_F(Cli, ASweepRefusesAPointDirectoryWithNoRoomForItsSnapshotsBeforeAnyPointRuns) {
+  // A root of 4040 characters: each point's directory (root/NAME) has room for its results but
+  // not for its snapshots. The sweep once started, wrote sweep.csv and failed every point
+  // (exit 1); it is now refused (exit 2) before anything is made.
+  write_config(base_config);
+  std::string out(200, 'a');
+  for (int k = 1; k < 20; ++k) out += "/" + std::string(200, 'a');
+  out += "/" + std::string(19, 'b');
+  ASSERT_EQ(out.size(), 4039U);
+  const Outcome o = millsim("sweep mill.toml -q -o " + out +
+                            " --vary mill.speed=0.5,0.6 --set simulation.revolutions=1 --set "
+                            "simulation.measure_revolutions=1 --set simulation.settle_time=0.01");
+  EXPECT_EQ(o.status, 2) << o.err;
+  EXPECT_NE(o.err.find("command line (--out " + out + "): output.directory: a path of "),
+            std::string::npos)
+      << o.err;
+  EXPECT_NE(o.err.find("leaves no room for the files the run writes in it (its "
+                       "snapshots/snapshot_0000000000.csv.partial would be a path of "),
+            std::string::npos)
+      << o.err;
+  EXPECT_FALSE(fs::exists(work_ / std::string(200, 'a'))) << "nothing is made";
+}
+
 TEST_F(Cli, AnUnknownCommandIsNamed) {
   const Outcome o = millsim("frobnicate mill.toml");
   EXPECT_EQ(o.status, 2) << o.err;
