@@ -221,7 +221,7 @@ TEST(SceneConfig, RefusesTooManyStepsWithACountThatReads) {
                   "allowed: at most 1e+10 steps"});
   // A subnormal step: 0.01 / 1e-320 overflows, and once read "inf steps".
   expect_refused(drop, {"simulation.time_step=1e-320"},
-                 {"is more than 1.8e+308 steps; allowed: at most 1e+10 steps"});
+                 {"is more than 1.7e+308 steps; allowed: at most 1e+10 steps"});
 }
 
 TEST(SceneConfig, RefusesAMillKeyInAScene) {

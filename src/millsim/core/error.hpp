@@ -34,10 +34,11 @@ inline std::string limit_text(double limit, Allowed allowed) {
 }
 
 /// A count of time steps computed from the user's values, for a refusal: "1.7e+13", or "more
-/// than 1.8e+308" when it overflowed (a time step of 1e-310 s gave "inf steps").
+/// than 1.7e+308" when it overflowed (a time step of 1e-310 s gave "inf steps"; a double
+/// overflows from about 1.798e308).
 inline std::string step_count_text(double count) {
   if (std::isfinite(count)) return fmt::format("{:.3g}", count);
-  return "more than 1.8e+308";
+  return "more than 1.7e+308";
 }
 
 }  // namespace millsim

@@ -551,7 +551,8 @@ std::vector<std::string_view> either_kind(std::span<const std::string_view> mill
   return names;
 }
 
-/// The first key of `table` not among `names`, with its node.
+/// The first key of `table` not among `names`, with its node (in toml++'s order, by name: of
+/// several, not necessarily the first in the file).
 std::optional<std::pair<std::string, const toml::node*>> first_unknown(
     const toml::table& table, std::span<const std::string_view> names) {
   for (const auto& [key, node] : table) {
