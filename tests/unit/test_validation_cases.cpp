@@ -78,7 +78,9 @@ TEST(ValidationCases, EachFileCarriesItsRowOfModelSection8) {
     double largest = 0.0;
     for (const SizeClass& size : config.sizes) largest = std::max(largest, size.diameter);
     EXPECT_EQ(largest, c.top_ball);
-    if (c.dimension == 3) EXPECT_EQ(config.sizes.size(), 1U);
+    if (c.dimension == 3) {
+      EXPECT_EQ(config.sizes.size(), 1U);
+    }
     // Steel: 7 800 kg/m³ (MODEL.md: 7 800–7 850, ours stated in docs/validation.md).
     EXPECT_EQ(config.density, 7800.0);
     // Table 1 (2D steel–steel) for both contact types; Table 3 (3D) ball–ball and ball–wall.
