@@ -430,14 +430,9 @@ TEST(LeapfrogStability, TheTangentialLimitBindsWhereItIsTheShorter) {
   EXPECT_GT(largest_slip_speed_on_floor(1.02, 200), 1e3);
 }
 
-// A disc dropped from centre height h0 onto the floor, tension allowed so that each bounce
-// returns the speed times e: the k-th apex of the centre is at (h0 − r) e^{2k} + r. Gravity
-// shifts the end of a contact by about g/(ω0 v), here ~1e-3 of the speed, which the stiff
-// spring (static overlap m g/k_n = 1e-6 m against a 0.45 m fall) keeps far below tolerance.
-TEST(BounceOnFloor, ApexHeightsFallAsRestitutionSquared) {
-  const double mass = 1.0;
-  const double drop_height = 0.5;  // h0, m
-  const ContactMaterial material{1.0e7, 2.0e7 / 3.0, 0.8, 0.5};
+/// A disc of `mass` at rest at `at` above a floor at y = 0, under gravity, the contact with
+/// tension (Corkum's restitution exactly) and Δt = t_c/steps_per_contact.
+World<2> disc_above_floor(const ContactMaterial& material, double mass, const Vec2& at) {
   WorldSettings<2> settings;
   settings.time_step = contact_duration(material, mass) / steps_per_contact;
   settings.gravity = Vec2{{0.0, -standard_gravity}};
@@ -446,7 +441,19 @@ TEST(BounceOnFloor, ApexHeightsFallAsRestitutionSquared) {
   Walls<2> walls;
   walls.planes.push_back(Plane<2>{Vec2{{0.0, 0.0}}, Vec2{{0.0, 1.0}}});
   World<2> world(settings, walls);
-  world.particles().add(Vec2{{0.0, drop_height}}, disc_radius, mass);
+  world.particles().add(at, disc_radius, mass);
+  return world;
+}
+
+// A disc dropped from centre height h0 onto the floor, tension allowed so that each bounce
+// returns the speed times e: the k-th apex of the centre is at (h0 − r) e^{2k} + r. Gravity
+// shifts the end of a contact by about g/(ω0 v), here ~1e-3 of the speed, which the stiff
+// spring (static overlap m g/k_n = 1e-6 m against a 0.45 m fall) keeps far below tolerance.
+TEST(BounceOnFloor, ApexHeightsFallAsRestitutionSquared) {
+  const double mass = 1.0;
+  const double drop_height = 0.5;  // h0, m
+  const ContactMaterial material{1.0e7, 2.0e7 / 3.0, 0.8, 0.5};
+  World<2> world = disc_above_floor(material, mass, Vec2{{0.0, drop_height}});
 
   const std::vector<double> apexes = bounce_apexes(world, 1, disc_radius, 3, 3.0);
   ASSERT_EQ(apexes.size(), 3U);
@@ -470,15 +477,7 @@ TEST(EnergyAccount, ABouncingDiscsPotentialEnergyIsMghAndItsAccountCloses) {
   const double drop_height = 0.5;  // h0, m
   const double g = standard_gravity;
   const ContactMaterial material{1.0e7, 2.0e7 / 3.0, 0.8, 0.5};
-  WorldSettings<2> settings;
-  settings.time_step = contact_duration(material, mass) / steps_per_contact;
-  settings.gravity = Vec2{{0.0, -g}};
-  settings.ball_wall = material;
-  settings.allow_tension = true;
-  Walls<2> walls;
-  walls.planes.push_back(Plane<2>{Vec2{{0.0, 0.0}}, Vec2{{0.0, 1.0}}});
-  World<2> world(settings, walls);
-  world.particles().add(Vec2{{0.3, drop_height}}, disc_radius, mass);
+  World<2> world = disc_above_floor(material, mass, Vec2{{0.3, drop_height}});
   const double initial = mass * g * drop_height;
   EXPECT_NEAR(world.potential_energy(), initial, 1e-12 * initial) << "−m g·x";
   EXPECT_EQ(world.kinetic_energy() + world.stored_spring_energy(), 0.0);

@@ -587,15 +587,21 @@ TEST_F(Cli, AResultsPartialNameTakenByADirectoryIsRefusedBeforeTheRun) {
   EXPECT_TRUE(fs::exists(work_ / "taken" / "spectrum.csv.partial" / "mine"));
 }
 
+/// A relative path near the system's limit: `directories` names of 200 letters a, then one of
+/// `last` letters b.
+std::string long_path(int directories, std::size_t last) {
+  std::string path(200, 'a');
+  for (int k = 1; k < directories; ++k) path += "/" + std::string(200, 'a');
+  return path + "/" + std::string(last, 'b');
+}
+
 TEST_F(Cli, AResultThatCannotBeMovedAsideRefusesTheRunAndPutsBackThoseThatWere) {
   // The earlier results are renamed into out/.millsim-earlier-results-XXXXXX/ before they are
   // removed. A path of 4046 characters leaves room for out/power_timeseries.csv (4067) but not
   // for it moved aside (4099, beyond the system's 4095): summary.json and power.csv are moved
   // first, then that rename fails, and they must be put back.
   write_config(base_config);
-  std::string out(200, 'a');
-  for (int k = 1; k < 19; ++k) out += "/" + std::string(200, 'a');
-  out += "/" + std::string(227, 'b');
+  const std::string out = long_path(19, 227);
   ASSERT_EQ(out.size(), 4046U);
   ASSERT_EQ(millsim("run mill.toml -q -o " + out + " " + tiny_run).status, 0);
   const std::string summary = read_all(work_ / out / "summary.json");
@@ -617,9 +623,7 @@ TEST_F(Cli, AnOutputPathWithNoRoomForTheSnapshotsIsRefusedBeforeTheRun) {
   // for out/snapshots/snapshot_0000000000.csv.partial (4102). Such a run once settled its charge
   // and then failed at its first snapshot (exit 1).
   write_config(base_config);
-  std::string out(200, 'a');
-  for (int k = 1; k < 19; ++k) out += "/" + std::string(200, 'a');
-  out += "/" + std::string(241, 'b');
+  const std::string out = long_path(19, 241);
   ASSERT_EQ(out.size(), 4060U);
   const std::string short_run =
       " --set simulation.revolutions=1 --set simulation.measure_revolutions=1 "
@@ -645,9 +649,7 @@ TEST_F(Cli, ASweepRefusesAPointDirectoryWithNoRoomForItsSnapshotsBeforeAnyPointR
   // not for its snapshots. The sweep once started, wrote sweep.csv and failed every point
   // (exit 1); it is now refused (exit 2) before anything is made.
   write_config(base_config);
-  std::string out(200, 'a');
-  for (int k = 1; k < 20; ++k) out += "/" + std::string(200, 'a');
-  out += "/" + std::string(19, 'b');
+  const std::string out = long_path(20, 19);
   ASSERT_EQ(out.size(), 4039U);
   const Outcome o = millsim("sweep mill.toml -q -o " + out +
                             " --vary mill.speed=0.5,0.6 --set simulation.revolutions=1 --set "
