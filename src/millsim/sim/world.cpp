@@ -167,6 +167,8 @@ void World<D>::refresh_neighbours(bool moved) {
     std::vector<std::uint32_t>& leaving = leaving_slots_[t];
     leaving.clear();
     std::size_t k = candidate_share_[t];
+    const std::size_t old_stride = wall_slot_history_.size() / slots;
+    const std::size_t new_stride = candidate_share_[team];
     for (std::size_t i = low; i < high; ++i) {
       const std::uint32_t held = wall_slots_of_[i];
       const std::size_t from = static_cast<std::size_t>(held) * slots;
@@ -180,21 +182,22 @@ void World<D>::refresh_neighbours(bool moved) {
       const std::size_t to = k * slots;
       for (std::size_t slot = 0; slot < slots; ++slot) {
         next_wall_slot_id_[to + slot] = held == no_wall_slots ? -1 : wall_slot_id_[from + slot];
-        next_wall_slot_history_[to + slot] =
-            held == no_wall_slots ? WallHistory{} : wall_slot_history_[from + slot];
+        next_wall_slot_history_[slot * new_stride + k] =
+            held == no_wall_slots ? WallHistory{} : wall_slot_history_[slot * old_stride + held];
       }
       ++k;
     }
   }
   candidate_share_.resize(team_size + 1);
   // The collisions of the particles that left, in particle order.
+  const std::size_t old_candidates = wall_slot_history_.size() / slots;
   for (std::size_t t = 0; t < team_size && spectrum_ != nullptr; ++t) {
     for (const std::uint32_t held : leaving_slots_[t]) {
       const std::size_t from = static_cast<std::size_t>(held) * slots;
-      for (std::size_t slot = from; slot < from + slots; ++slot) {
-        if (wall_slot_id_[slot] < 0) continue;
-        spectrum_->record(wall_contact_type(walls_.kind_of(wall_slot_id_[slot])),
-                          wall_slot_history_[slot].dissipated);
+      for (std::size_t slot = 0; slot < slots; ++slot) {
+        if (wall_slot_id_[from + slot] < 0) continue;
+        spectrum_->record(wall_contact_type(walls_.kind_of(wall_slot_id_[from + slot])),
+                          wall_slot_history_[slot * old_candidates + held].dissipated);
       }
     }
   }
@@ -403,7 +406,9 @@ double World<D>::stored_spring_energy() const {
   }
   for (std::size_t s = 0; s < wall_slot_id_.size(); ++s) {
     if (wall_slot_id_[s] >= 0) {
-      energy += ball_wall_law_.stored_energy(wall_slot_history_[s], wall_slot_history_[s].overlap);
+      const WallHistory& held =
+          wall_slot_history_[wall_history_index(s / max_wall_contacts, s % max_wall_contacts)];
+      energy += ball_wall_law_.stored_energy(held, held.overlap);
     }
   }
   return energy;
@@ -427,7 +432,9 @@ double World<D>::largest_overlap_fraction() const {
   for (std::size_t s = 0; s < wall_slot_id_.size(); ++s) {
     if (wall_slot_id_[s] < 0) continue;
     const std::uint32_t i = wall_candidates_[s / max_wall_contacts];
-    largest = std::max(largest, wall_slot_history_[s].overlap / p.radius[i]);
+    const WallHistory& held =
+        wall_slot_history_[wall_history_index(s / max_wall_contacts, s % max_wall_contacts)];
+    largest = std::max(largest, held.overlap / p.radius[i]);
   }
   return largest;
 }

@@ -121,7 +121,12 @@ void World<D>::evaluate_wall_candidates(std::size_t b, std::size_t begin, std::s
       first_work[k - begin + 1] = static_cast<std::uint32_t>(found);
       continue;
     }
-    WallHistory* slot_history = &wall_slot_history_[k * max_wall_contacts];
+    // The candidate's slots' histories, one array of candidates per slot (wall_history_index).
+    const std::size_t slot_stride = wall_candidates_.size();
+    WallHistory* const slot_history = &wall_slot_history_[k];
+    const auto history_at = [&](int slot) -> WallHistory& {
+      return slot_history[static_cast<std::size_t>(slot) * slot_stride];
+    };
     unsigned seen = 0;  // bit s: slot s touched now
     const NearbyLifters* nearby = nearby_lifters_.empty() ? nullptr : &nearby_lifters_[k];
     if (found_list.size() < found + most) {
@@ -142,17 +147,16 @@ void World<D>::evaluate_wall_candidates(std::size_t b, std::size_t begin, std::s
         if (slot == max_wall_contacts) continue;  // cannot happen: see max_wall_contacts
         slot_id[slot] = wall_id;
         // A collision begins: where, for ShellImpacts (its history is fresh, all zero).
-        slot_history[slot].start_angle = std::atan2(contact[c].point[1], contact[c].point[0]);
+        history_at(slot).start_angle = std::atan2(contact[c].point[1], contact[c].point[0]);
       }
       seen |= 1U << static_cast<unsigned>(slot);
       // The slot's history, which the law reads and writes once the block's contacts are found:
       // in a large world it is in memory, one slot here and there.
-      if (prefetch_pairs_) prefetch_record(slot_history[slot], true);
+      if (prefetch_pairs_) prefetch_record(history_at(slot), true);
       if (kept_count != c) contact[kept_count] = contact[c];
       WallWork& work_of = work_list[found + static_cast<std::size_t>(kept_count)];
       work_of.particle = i;
-      work_of.slot =
-          static_cast<std::uint32_t>(k * max_wall_contacts) + static_cast<std::uint32_t>(slot);
+      work_of.slot = static_cast<std::uint32_t>(wall_history_index(k, slot));
       ++kept_count;
     }
     found += static_cast<std::size_t>(kept_count);
@@ -166,9 +170,9 @@ void World<D>::evaluate_wall_candidates(std::size_t b, std::size_t begin, std::s
     for (unsigned ended_slots = held & ~seen; ended_slots != 0; ended_slots &= ended_slots - 1) {
       const int slot = std::countr_zero(ended_slots);
       end_collision({.type = wall_contact_type(walls_.kind_of(slot_id[slot])),
-                     .start_angle = static_cast<float>(slot_history[slot].start_angle),
-                     .energy = slot_history[slot].dissipated});
-      slot_history[slot] = WallHistory{};
+                     .start_angle = static_cast<float>(history_at(slot).start_angle),
+                     .energy = history_at(slot).dissipated});
+      history_at(slot) = WallHistory{};
       slot_id[slot] = -1;
     }
   }
