@@ -22,22 +22,27 @@ constexpr double time_step = 2e-5;
 /// balls at x = 1 m are dropped in turn from heights that bring them to the floor, and back
 /// up, at different times, so that they join and leave the wall candidates before and after
 /// the resting ball; they never come near it. The crowd is added first, so that it comes
-/// before the resting ball in the candidate list.
-World<3> ball_on_floor(bool crowd, int steps, ImpactSpectrum* spectrum = nullptr) {
+/// before the resting ball in the candidate list. With `side_wall`, a second plane (y = 0,
+/// normal +y) that a sideways pull of gravity keeps the ball pressed against as it slides: its
+/// second wall contact, held in its second slot.
+World<3> ball_on_floor(bool crowd, int steps, ImpactSpectrum* spectrum = nullptr,
+                       bool side_wall = false) {
   WorldSettings<3> settings;
   settings.time_step = time_step;
-  settings.gravity = Vec3{{0.0, 0.0, -9.81}};
+  settings.gravity = Vec3{{0.0, side_wall ? -2.0 : 0.0, -9.81}};
   settings.ball_wall.friction = 0.6;
   Walls<3> walls;
   walls.planes.push_back(Plane<3>{Vec3{}, Vec3{{0.0, 0.0, 1.0}}});
+  if (side_wall) walls.planes.push_back(Plane<3>{Vec3{}, Vec3{{0.0, 1.0, 0.0}}});
   World<3> world(settings, walls);
+  const double y = side_wall ? radius - 1e-6 : 0.0;
   if (crowd) {
     for (int k = 0; k < 6; ++k) {
-      world.particles().add(Vec3{{1.0, 0.03 * k, radius + 0.002 + 0.004 * k}}, radius, mass,
+      world.particles().add(Vec3{{1.0, 0.05 + 0.03 * k, radius + 0.002 + 0.004 * k}}, radius, mass,
                             Vec3{{0.0, 0.0, 0.3 - 0.1 * k}});
     }
   }
-  world.particles().add(Vec3{{0.0, 0.0, radius - 1e-6}}, radius, mass, Vec3{{0.2, 0.0, 0.0}});
+  world.particles().add(Vec3{{0.0, y, radius - 1e-6}}, radius, mass, Vec3{{0.2, 0.0, 0.0}});
   world.record_collisions_in(spectrum);
   for (int n = 0; n < steps; ++n) world.step();
   world.record_collisions_in(nullptr);
@@ -61,6 +66,28 @@ TEST(WallHistory, ABallsFloorContactIgnoresBallsJoiningAndLeavingTheWallCandidat
   EXPECT_GT(crowded.neighbour_rebuilds(), alone.neighbour_rebuilds() + 5);
   EXPECT_GT(std::abs(crowded.particles().angular_velocity[last][1]), 1.0);
   EXPECT_GE(crowded.touching_contacts(), 1u);
+  EXPECT_GE(spectrum.total_count(ContactType::ball_plane), 3);
+  EXPECT_LT(crowded.wall_candidate_count(), crowded.particles().size());
+}
+
+TEST(WallHistory, ABallsTwoWallContactsIgnoreBallsJoiningAndLeavingTheWallCandidates) {
+  // The same with the ball in the corner of the floor and a side wall: each candidate's second
+  // slot is carried to its new place at every rebuild as its first is (the histories are kept
+  // slot by slot, each slot an array over the candidates, whose number the crowd changes).
+  const int steps = 3000;
+  const World<3> alone = ball_on_floor(false, steps, nullptr, true);
+  ImpactSpectrum spectrum;
+  const World<3> crowded = ball_on_floor(true, steps, &spectrum, true);
+  const std::size_t last = crowded.particles().size() - 1;
+  EXPECT_EQ(alone.particles().position[0], crowded.particles().position[last]);
+  EXPECT_EQ(alone.particles().velocity[0], crowded.particles().velocity[last]);
+  EXPECT_EQ(alone.particles().angular_velocity[0], crowded.particles().angular_velocity[last]);
+  // Both of the ball's contacts held to the end, its side contact's spring loaded (it spins
+  // about z as well as y), and the crowd changed the candidates at the rebuilds.
+  EXPECT_EQ(alone.touching_contacts(), 2u);
+  EXPECT_GT(std::abs(crowded.particles().angular_velocity[last][1]), 1.0);
+  EXPECT_GT(std::abs(crowded.particles().angular_velocity[last][2]), 1.0);
+  EXPECT_GT(crowded.neighbour_rebuilds(), alone.neighbour_rebuilds() + 5);
   EXPECT_GE(spectrum.total_count(ContactType::ball_plane), 3);
   EXPECT_LT(crowded.wall_candidate_count(), crowded.particles().size());
 }

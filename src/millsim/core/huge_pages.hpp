@@ -10,7 +10,7 @@
 
 namespace millsim {
 
-/// The size of a transparent huge page on x86-64 Linux.
+/// The size of a transparent huge page on x86-64 Linux (and arm64 with 4 KiB pages).
 inline constexpr std::uintptr_t huge_page_bytes = std::uintptr_t{2} << 20U;
 
 /// Addresses [begin, end).
@@ -30,19 +30,23 @@ constexpr AddressRange whole_huge_pages(std::uintptr_t start, std::size_t bytes)
 
 /// Asks that the whole huge pages inside [data, data + bytes) be backed by transparent huge pages
 /// when first touched (MADV_HUGEPAGE; pages already touched stay as they are). A hint: where the
-/// kernel has no such pages (transparent_hugepage "never") or refuses, nothing changes, and the
-/// result is not checked. The memory must be the caller's own.
-inline void advise_huge_pages(const void* data, std::size_t bytes) {
+/// kernel has no such pages or refuses, nothing changes; returns whether the kernel took it
+/// (false also where no whole huge page fits), which the callers need not check. The memory
+/// must be the caller's own. Where a huge page is not 2 MiB (arm64 with 64 KiB pages, say), the
+/// advice covers whole 2 MiB blocks and the kernel does what it can with them.
+inline bool advise_huge_pages(const void* data, std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
   const AddressRange range = whole_huge_pages(reinterpret_cast<std::uintptr_t>(data), bytes);
   if (range.end > range.begin) {
     // NOLINTNEXTLINE(performance-no-int-to-ptr): an address range for the kernel
     void* const first = reinterpret_cast<void*>(range.begin);
-    static_cast<void>(madvise(first, range.end - range.begin, MADV_HUGEPAGE));
+    return madvise(first, range.end - range.begin, MADV_HUGEPAGE) == 0;
   }
+  return false;
 #else
   static_cast<void>(data);
   static_cast<void>(bytes);
+  return false;
 #endif
 }
 
