@@ -137,6 +137,8 @@ void World<D>::refresh_neighbours(bool moved) {
   candidate_share_.assign(most + 1, 0);
   if (leaving_slots_.size() < most) leaving_slots_.resize(most);
   is_candidate_.resize(count);
+  // The last list's candidate count: the stride of its histories' slots (wall_history_index).
+  const std::size_t old_candidates = wall_slot_history_.size() / slots;
   std::size_t team_size = 1;
 #pragma omp parallel if (parallel_candidates)
   {
@@ -167,8 +169,7 @@ void World<D>::refresh_neighbours(bool moved) {
     std::vector<std::uint32_t>& leaving = leaving_slots_[t];
     leaving.clear();
     std::size_t k = candidate_share_[t];
-    const std::size_t old_stride = wall_slot_history_.size() / slots;
-    const std::size_t new_stride = candidate_share_[team];
+    const std::size_t new_candidates = candidate_share_[team];
     for (std::size_t i = low; i < high; ++i) {
       const std::uint32_t held = wall_slots_of_[i];
       const std::size_t from = static_cast<std::size_t>(held) * slots;
@@ -182,15 +183,15 @@ void World<D>::refresh_neighbours(bool moved) {
       const std::size_t to = k * slots;
       for (std::size_t slot = 0; slot < slots; ++slot) {
         next_wall_slot_id_[to + slot] = held == no_wall_slots ? -1 : wall_slot_id_[from + slot];
-        next_wall_slot_history_[slot * new_stride + k] =
-            held == no_wall_slots ? WallHistory{} : wall_slot_history_[slot * old_stride + held];
+        next_wall_slot_history_[slot * new_candidates + k] =
+            held == no_wall_slots ? WallHistory{}
+                                  : wall_slot_history_[slot * old_candidates + held];
       }
       ++k;
     }
   }
   candidate_share_.resize(team_size + 1);
   // The collisions of the particles that left, in particle order.
-  const std::size_t old_candidates = wall_slot_history_.size() / slots;
   for (std::size_t t = 0; t < team_size && spectrum_ != nullptr; ++t) {
     for (const std::uint32_t held : leaving_slots_[t]) {
       const std::size_t from = static_cast<std::size_t>(held) * slots;

@@ -121,11 +121,9 @@ void World<D>::evaluate_wall_candidates(std::size_t b, std::size_t begin, std::s
       first_work[k - begin + 1] = static_cast<std::uint32_t>(found);
       continue;
     }
-    // The candidate's slots' histories, one array of candidates per slot (wall_history_index).
-    const std::size_t slot_stride = wall_candidates_.size();
-    WallHistory* const slot_history = &wall_slot_history_[k];
+    // The candidate's slots' histories, one array of candidates per slot.
     const auto history_at = [&](int slot) -> WallHistory& {
-      return slot_history[static_cast<std::size_t>(slot) * slot_stride];
+      return wall_slot_history_[wall_history_index(k, static_cast<std::size_t>(slot))];
     };
     unsigned seen = 0;  // bit s: slot s touched now
     const NearbyLifters* nearby = nearby_lifters_.empty() ? nullptr : &nearby_lifters_[k];
