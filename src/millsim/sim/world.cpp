@@ -116,6 +116,14 @@ void World<D>::refresh_neighbours(bool moved) {
   // The arrays of prefetch_pairs.
   constexpr std::size_t kernel_bytes = 3 * sizeof(Vec<D>) + 3 * sizeof(Spin<D>) + sizeof(double);
   prefetch_pairs_ = count * kernel_bytes > prefetch_threshold_bytes;
+  if constexpr (D == 3) {
+    // The arrays of prefetch_particles.
+    constexpr std::size_t window_bytes =
+        4 * sizeof(Vec<D>) + 3 * sizeof(Spin<D>) + 2 * sizeof(double);
+    pair_window_ = prefetch_pairs_ && count * window_bytes > pair_window_threshold_bytes
+                       ? pair_window_for(neighbours_.first(), neighbours_.second(), window_bytes)
+                       : 0;
+  }
   pair_block_ = block_size_for(pairs, 16, min_pair_block, max_pair_block);
   pair_block_ended_.resize(block_count(pairs, pair_block_));
   pair_block_dissipated_.resize(block_count(pairs, pair_block_));

@@ -375,6 +375,10 @@ class World {
   /// [begin, end): their history, and both particles' velocities, spins, masses and sums.
   [[gnu::always_inline]] inline void prefetch_pairs(const std::uint32_t* listed, std::size_t begin,
                                                     std::size_t end);
+  /// Asks the processor to fetch every cache line of the pair kernel's particle arrays (those
+  /// of prefetch_pairs, and the positions and radii) that holds a part of particles [from, to),
+  /// into its second-level cache (pair_window_).
+  [[gnu::always_inline]] inline void prefetch_particles(std::size_t from, std::size_t to);
   void split_pairs_among(int threads);
   /// Whether the pair stage runs on several threads; if so, makes sure its split of particles
   /// and pairs among them (split_pairs_among) is that of the current list and thread count.
@@ -657,6 +661,15 @@ class World {
   /// prefetch_pairs, the one-pair-at-a-time first pass, the wall slots' histories, the 3D
   /// integration): set at each rebuild from the size of the particle arrays (above 1 MiB).
   bool prefetch_pairs_ = false;
+  /// In 3D worlds whose arrays outgrow the last-level cache, how many particles beyond a pair's
+  /// first the pair kernel has the particle arrays fetched: as it goes down the pairs it asks
+  /// for every line of those arrays up to first + pair_window_ (prefetch_particles), so that
+  /// the second particles, met out of order up to a layer of cells ahead in the cell order,
+  /// are in the second-level cache when their pairs come; prefetch_pairs then brings each
+  /// pair's lines from there into the first-level cache. (Pair by pair alone, the fetch from
+  /// memory came too late: the 1e6-ball slab 30 % slower, bench/results.md, forty-first
+  /// session.) Set at each rebuild (world_detail::pair_window_for); 0: no window.
+  std::size_t pair_window_ = 0;
   std::vector<NearbyLifters> nearby_lifters_;
   double nearby_lifter_angle_ = 0.0;
   double lifter_travel_ = 0.0;

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <bit>
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "millsim/geometry/walls.hpp"
 #include "millsim/measure/spectrum.hpp"
@@ -76,6 +78,35 @@ inline bool splits_among_threads(std::size_t pairs, int threads) {
 /// 1e4-ball slab, 1.5 MB, 2–4 % faster; the 3D 20 k scene and the LIGGGHTS comparison's, 3 MB,
 /// 3–8 % faster; the 1e5-ball slab, 15 MB, +10 % in the eleventh).
 inline constexpr std::size_t prefetch_threshold_bytes = std::size_t{1} << 20;
+
+/// The pair kernel's window of prefetched particles (World::pair_window_): the furthest a
+/// listed pair's second particle lies beyond its first (the list gives the lower index first)
+/// among the pairs within the largest window, plus pair_window_lead particles so that the last
+/// ones' lines have time to arrive. The largest window is pair_window_bytes of the arrays
+/// (`bytes_per_particle` each), a quarter of the AMD host's 1 MiB second-level cache. Pairs
+/// beyond it (in a cell-ordered periodic slab those across its ends, whose second particle is
+/// at the far end of the list: 1 % of the 1e4-ball slab's pairs, 0.01 % of the 1e6-ball
+/// slab's) have only World::prefetch_pairs' fetch, a few pairs ahead. In the 1e6-ball slab the
+/// window is 393 particles (99.9 % of the pairs' second particles lie within 347 of the first).
+inline constexpr std::size_t pair_window_lead = 32;
+/// The window is kept from this size of its arrays up: where the world's arrays outgrow the
+/// last-level cache. Below it the kernel finds the second particles in that cache, and fetching
+/// every line ahead costs more than it saves (bench/results.md, forty-first session, one
+/// thread on the AMD host with 32 MiB of L3: the 3e4-ball slab, 5.5 MB of these arrays, 4 %
+/// slower with the window; the 5e4-ball slab, 9.2 MB, 11 % faster; 1e5 and 1e6, 30 %).
+inline constexpr std::size_t pair_window_threshold_bytes = std::size_t{8} << 20;
+inline constexpr std::size_t pair_window_bytes = std::size_t{256} << 10;
+inline std::size_t pair_window_for(const std::vector<std::uint32_t>& first,
+                                   const std::vector<std::uint32_t>& second,
+                                   std::size_t bytes_per_particle) {
+  const std::size_t largest = pair_window_bytes / std::max<std::size_t>(1, bytes_per_particle);
+  std::size_t furthest = 0;
+  for (std::size_t q = 0; q < first.size(); ++q) {
+    const std::size_t gap = second[q] - first[q];
+    furthest = gap + pair_window_lead <= largest ? std::max(furthest, gap) : furthest;
+  }
+  return furthest + pair_window_lead;
+}
 
 inline std::size_t block_count(std::size_t items, std::size_t block) {
   return (items + block - 1) / block;

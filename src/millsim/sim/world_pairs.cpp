@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <cstring>
 
 #include "millsim/core/prefetch.hpp"
@@ -304,6 +305,39 @@ void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, st
 }
 
 template <int D>
+void World<D>::prefetch_particles(std::size_t from, std::size_t to) {
+  // Every cache line that holds a part of particles [from, to) of an array, into the
+  // second-level cache (locality 2): the window is larger than the first-level cache, into
+  // which prefetch_pairs brings each pair's lines just before the kernel reads them. The sums
+  // too are only read: a line no other core holds arrives exclusive, and the kernel's write
+  // then needs no second fetch.
+  // (Steps of a line from the first byte meet every line but perhaps the last, which the last
+  // byte's fetch takes.)
+  const auto lines = [ from, to ](const auto& array) __attribute__((always_inline)) {
+    if (from >= to) return;
+    constexpr std::ptrdiff_t line = 64;
+    const char* const begin = reinterpret_cast<const char*>(array.data() + from);
+    const auto bytes = static_cast<std::ptrdiff_t>((to - from) * sizeof(array[0]));
+    for (std::ptrdiff_t at = 0; at < bytes; at += line) __builtin_prefetch(begin + at, 0, 2);
+    __builtin_prefetch(begin + bytes - 1, 0, 2);
+  };
+  const auto& p = particles_;
+  lines(p.position);
+  lines(p.radius);
+  lines(velocity_now_);
+  lines(rim_speed_now_);
+  lines(p.velocity);
+  if constexpr (keeps_step_rim) {
+    lines(rim_speed_step_);
+  } else {
+    lines(p.angular_velocity);
+  }
+  if (!uniform_mass_) lines(p.mass);
+  lines(p.force);
+  lines(p.torque);
+}
+
+template <int D>
 void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint32_t* listed,
                                               std::size_t count, double& dissipated_sum,
                                               std::uint32_t& ended_count, bool each_apart,
@@ -328,7 +362,20 @@ void World<D>::evaluate_listed_pairs_in_lanes(std::size_t block, const std::uint
   const bool periodic = neighbours_.period() > 0.0;
   [[maybe_unused]] const T period = splat<T>(neighbours_.period());
 
+  // The window of prefetched particles (pair_window_) ends here: the earlier blocks of the run
+  // have fetched up to it. (A run's first block starts with the window not yet fetched.)
+  const std::size_t particle_count = particles_.size();
+  std::size_t window_end =
+      count > 0 ? std::min(particle_count, neighbours_.first()[listed[0]] + pair_window_) : 0;
   for (std::size_t k = 0; k < count; k += lanes) {
+    if (pair_window_ > 0) {
+      const std::size_t ahead =
+          std::min(particle_count, neighbours_.first()[listed[k]] + pair_window_);
+      if (ahead > window_end) {
+        prefetch_particles(window_end, ahead);
+        window_end = ahead;
+      }
+    }
     if (prefetch_pairs_)
       prefetch_pairs(listed, std::min(count, k + 2 * lanes), std::min(count, k + 3 * lanes));
     // The pairs of the lanes; where fewer remain, the last one fills the rest (the caller has
