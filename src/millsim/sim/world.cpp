@@ -115,14 +115,17 @@ void World<D>::refresh_neighbours(bool moved) {
   pair_ended_.resize(pairs);
   // The arrays of prefetch_pairs.
   constexpr std::size_t kernel_bytes = 3 * sizeof(Vec<D>) + 3 * sizeof(Spin<D>) + sizeof(double);
-  prefetch_pairs_ = count * kernel_bytes > prefetch_threshold_bytes;
+  const bool sizes_set = prefetch_from_bytes_ > 0;  // by a test: set_prefetch_from
+  const std::size_t pairs_from = sizes_set ? prefetch_from_bytes_ : prefetch_threshold_bytes;
+  const std::size_t window_from = sizes_set ? prefetch_from_bytes_ : pair_window_threshold_bytes;
+  prefetch_pairs_ = count * kernel_bytes > pairs_from;
   if constexpr (D == 3) {
     // The arrays of prefetch_particles.
     constexpr std::size_t window_bytes =
         4 * sizeof(Vec<D>) + 3 * sizeof(Spin<D>) + 2 * sizeof(double);
-    pair_window_ = prefetch_pairs_ && count * window_bytes > pair_window_threshold_bytes
-                       ? pair_window_for(neighbours_.first(), neighbours_.second(), window_bytes)
-                       : 0;
+    const bool window = prefetch_pairs_ && count * window_bytes > window_from;
+    pair_window_ =
+        window ? pair_window_for(neighbours_.first(), neighbours_.second(), window_bytes) : 0;
   }
   pair_block_ = block_size_for(pairs, 16, min_pair_block, max_pair_block);
   pair_block_ended_.resize(block_count(pairs, pair_block_));

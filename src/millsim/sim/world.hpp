@@ -191,6 +191,13 @@ class World {
   }
   /// Whether the kernels take that shortcut now (as of the last step).
   bool uniform_mass() const { return uniform_mass_; }
+  /// From the next rebuild, prefetch (prefetch_pairs, and in 3D the pair kernel's window of
+  /// particles) in any world whose kernel arrays exceed `bytes`, instead of from the built-in
+  /// sizes (world_detail::prefetch_threshold_bytes, pair_window_threshold_bytes); 0 puts those
+  /// back. Prefetching changes no value; tests turn it on in small worlds to show that.
+  void set_prefetch_from(std::size_t bytes) { prefetch_from_bytes_ = bytes; }
+  /// The pair kernel's window of prefetched particles as of the last rebuild (0: none).
+  std::size_t pair_window() const { return pair_window_; }
   /// How often the lists of nearby lifters were made, at rebuilds and because the mill had
   /// turned too far since.
   long nearby_lifter_refreshes() const { return nearby_lifter_refreshes_; }
@@ -670,6 +677,7 @@ class World {
   /// memory came too late: the 1e6-ball slab 30 % slower, bench/results.md, forty-first
   /// session.) Set at each rebuild (world_detail::pair_window_for); 0: no window.
   std::size_t pair_window_ = 0;
+  std::size_t prefetch_from_bytes_ = 0;  // set_prefetch_from; 0: the built-in sizes
   std::vector<NearbyLifters> nearby_lifters_;
   double nearby_lifter_angle_ = 0.0;
   double lifter_travel_ = 0.0;
