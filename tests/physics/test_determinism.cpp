@@ -509,9 +509,9 @@ TEST(Determinism, ChargeOfOneMassGivesTheBitsOfDashpotsWorkedOutForEachContact) 
 
 TEST(Determinism, PrefetchingAheadOfThePairKernelChangesNoBit) {
   // Prefetching is for worlds beyond the caches (World::prefetch_pairs from 1 MiB of the
-  // kernel's arrays, the 3D window of particles from 8 MiB: about 45 000 balls); forced on here
-  // in the periodic slab of 5 184 balls, whose pairs across the slab's ends lie beyond the
-  // window, on one and two threads, it gives the bits of the run without it.
+  // arrays it fetches, the 3D window of particles from 8 MiB of its own: about 45 000 balls);
+  // forced on here in the periodic slab of 5 184 balls, on one and two threads (the cross pairs
+  // and shared blocks of two runs too), it gives the bits of the run without it.
   const MillPlan plan = plan_mill(parse_mill_config(short_wide_mill(true), "periodic-slab.toml"));
   const World<3> scene = moving_scene<3>(plan, 0.0, 1.0, 4.0, 200);
   const Outcome<3> plain = step_on(scene, 300, 1);
@@ -523,8 +523,7 @@ TEST(Determinism, PrefetchingAheadOfThePairKernelChangesNoBit) {
     fetched.world.record_collisions_in(&fetched.spectrum);
     for (int n = 0; n < 300; ++n) fetched.world.step();
     fetched.world.record_collisions_in(nullptr);
-    EXPECT_GT(fetched.world.pair_window(), world_detail::pair_window_lead);
-    EXPECT_LT(fetched.world.pair_window(), fetched.world.particles().size());
+    EXPECT_GT(fetched.world.pair_window(), world_detail::pair_window_lead) << "window on";
     expect_identical(plain, fetched);
   }
   EXPECT_GT(plain.world.touching_contacts(), 100u);

@@ -191,10 +191,10 @@ class World {
   }
   /// Whether the kernels take that shortcut now (as of the last step).
   bool uniform_mass() const { return uniform_mass_; }
-  /// From the next rebuild, prefetch (prefetch_pairs, and in 3D the pair kernel's window of
-  /// particles) in any world whose kernel arrays exceed `bytes`, instead of from the built-in
-  /// sizes (world_detail::prefetch_threshold_bytes, pair_window_threshold_bytes); 0 puts those
-  /// back. Prefetching changes no value; tests turn it on in small worlds to show that.
+  /// From the next rebuild, `bytes` replaces both built-in sizes from which the step prefetches
+  /// (world_detail::prefetch_threshold_bytes, for prefetch_pairs' arrays, and
+  /// pair_window_threshold_bytes, for the 3D window's); 0 puts them back. Prefetching changes
+  /// no value; tests turn it on in small worlds to show that.
   void set_prefetch_from(std::size_t bytes) { prefetch_from_bytes_ = bytes; }
   /// The pair kernel's window of prefetched particles as of the last rebuild (0: none).
   std::size_t pair_window() const { return pair_window_; }

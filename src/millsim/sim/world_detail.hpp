@@ -84,9 +84,10 @@ inline constexpr std::size_t prefetch_threshold_bytes = std::size_t{1} << 20;
 /// among the pairs within the largest window, plus pair_window_lead particles so that the last
 /// ones' lines have time to arrive. The largest window is pair_window_bytes of the arrays
 /// (`bytes_per_particle` each), a quarter of the AMD host's 1 MiB second-level cache. Pairs
-/// beyond it (in a cell-ordered periodic slab those across its ends, whose second particle is
-/// at the far end of the list: 1 % of the 1e4-ball slab's pairs, 0.01 % of the 1e6-ball
-/// slab's) have only World::prefetch_pairs' fetch, a few pairs ahead. In the 1e6-ball slab the
+/// beyond it have only World::prefetch_pairs' fetch, a few pairs ahead: in the tiled slabs of
+/// the scaling series, whose axis is the cell grid's outermost, those across the slab's ends,
+/// whose second particle is at the far end of the list (1 % of the 1e4-ball slab's pairs,
+/// 0.01 % of the 1e6-ball slab's). In the 1e6-ball slab the
 /// window is 393 particles (99.9 % of the pairs' second particles lie within 347 of the first).
 inline constexpr std::size_t pair_window_lead = 32;
 /// The window is kept from this size of its arrays up: where the world's arrays outgrow the

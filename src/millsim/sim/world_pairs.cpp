@@ -306,20 +306,14 @@ void World<D>::prefetch_pairs(const std::uint32_t* listed, std::size_t begin, st
 
 template <int D>
 void World<D>::prefetch_particles(std::size_t from, std::size_t to) {
-  // Every cache line that holds a part of particles [from, to) of an array, into the
-  // second-level cache (locality 2): the window is larger than the first-level cache, into
-  // which prefetch_pairs brings each pair's lines just before the kernel reads them. The sums
-  // too are only read: a line no other core holds arrives exclusive, and the kernel's write
-  // then needs no second fetch.
-  // (Steps of a line from the first byte meet every line but perhaps the last, which the last
-  // byte's fetch takes.)
+  // Into the second-level cache: the window is larger than the first-level cache, into which
+  // prefetch_pairs brings each pair's lines just before the kernel reads them. The sums too are
+  // only read: a line no other core holds arrives exclusive, and the kernel's write then needs
+  // no second fetch. (Near the end of a thread's run the window reaches into the next run's
+  // particles, whose lines another core writes; a prefetch changes no value.)
+  if (from >= to) return;
   const auto lines = [ from, to ](const auto& array) __attribute__((always_inline)) {
-    if (from >= to) return;
-    constexpr std::ptrdiff_t line = 64;
-    const char* const begin = reinterpret_cast<const char*>(array.data() + from);
-    const auto bytes = static_cast<std::ptrdiff_t>((to - from) * sizeof(array[0]));
-    for (std::ptrdiff_t at = 0; at < bytes; at += line) __builtin_prefetch(begin + at, 0, 2);
-    __builtin_prefetch(begin + bytes - 1, 0, 2);
+    prefetch_lines_for_l2(array.data() + from, to - from);
   };
   const auto& p = particles_;
   lines(p.position);
