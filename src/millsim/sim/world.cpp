@@ -120,9 +120,8 @@ void World<D>::refresh_neighbours(bool moved) {
   const std::size_t window_from = sizes_set ? prefetch_from_bytes_ : pair_window_threshold_bytes;
   prefetch_pairs_ = count * kernel_bytes > pairs_from;
   if constexpr (D == 3) {
-    // The arrays of prefetch_particles.
-    constexpr std::size_t window_bytes =
-        4 * sizeof(Vec<D>) + 3 * sizeof(Spin<D>) + 2 * sizeof(double);
+    // The arrays of prefetch_particles: those of prefetch_pairs, the positions and the radii.
+    constexpr std::size_t window_bytes = kernel_bytes + sizeof(Vec<D>) + sizeof(double);
     const bool window = prefetch_pairs_ && count * window_bytes > window_from;
     pair_window_ =
         window ? pair_window_for(neighbours_.first(), neighbours_.second(), window_bytes) : 0;

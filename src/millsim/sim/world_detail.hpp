@@ -87,8 +87,8 @@ inline constexpr std::size_t prefetch_threshold_bytes = std::size_t{1} << 20;
 /// beyond it have only World::prefetch_pairs' fetch, a few pairs ahead: in the tiled slabs of
 /// the scaling series, whose axis is the cell grid's outermost, those across the slab's ends,
 /// whose second particle is at the far end of the list (1 % of the 1e4-ball slab's pairs,
-/// 0.01 % of the 1e6-ball slab's). In the 1e6-ball slab the
-/// window is 393 particles (99.9 % of the pairs' second particles lie within 347 of the first).
+/// 0.01 % of the 1e6-ball slab's). In the 1e6-ball slab the window is 393 particles (99.9 % of
+/// the pairs' second particles lie within 347 of the first).
 inline constexpr std::size_t pair_window_lead = 32;
 /// The window is kept from this size of its arrays up: where the world's arrays outgrow the
 /// last-level cache. Below it the kernel finds the second particles in that cache, and fetching
