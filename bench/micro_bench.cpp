@@ -1,0 +1,166 @@
+// Micro-benchmarks (Google Benchmark): one stage of the step at a time on a settled charge,
+// for work on that stage, where scene_bench.cpp times whole steps (results in
+// bench/results.md). So far the neighbour-list rebuild, on one and on two threads.
+//
+//   millsim_micro_bench [--config FILE] [--set KEY=VALUE ...] [--settle-seconds S]
+//                       [Google Benchmark's flags: --benchmark_filter=...,
+//                       --benchmark_repetitions=N]
+//
+// The charge is the config's mill (default: the 2D SAG scene, bench/sag-12m-2d.toml) settled
+// for the config's settle_time, or S seconds of mill time (0: as placed).
+
+#include <benchmark/benchmark.h>
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "millsim/core/error.hpp"
+#include "millsim/io/config.hpp"
+#include "millsim/search/neighbour_list.hpp"
+#include "millsim/sim/charge.hpp"
+
+namespace {
+
+/// What the benchmarks start from: the settled charge's positions and radii, and the skin the
+/// world chose at its last rebuild.
+template <int D>
+struct Charge {
+  std::vector<millsim::Vec<D>> position;
+  std::vector<double> radius;
+  double skin = 0.0;
+};
+
+template <int D>
+Charge<D> settled_charge(const millsim::MillPlan& plan, double settle_seconds) {
+  millsim::World<D> world = millsim::build_mill_world<D>(plan);
+  while (world.time() < settle_seconds) world.step();
+  if (world.neighbour_rebuilds() == 0) world.step();  // a skin chosen for this charge
+  return {world.particles().position, world.particles().radius, world.neighbour_skin()};
+}
+
+/// The charge the benchmarks time: settled in main before they run.
+std::variant<std::monostate, Charge<2>, Charge<3>> the_charge;
+
+/// A rebuild of the charge's list, the particles where they are (the histories carried from
+/// the list before, which holds the same pairs) and not renumbered: NeighbourList::rebuild
+/// as World calls it between cell orderings. state.range(0): the threads.
+template <int D>
+void rebuild_list(benchmark::State& state, const Charge<D>& charge) {
+  const int threads = static_cast<int>(state.range(0));
+  omp_set_num_threads(threads);
+  millsim::NeighbourList<D> list(charge.skin);
+  list.set_parallel(threads > 1);
+  list.rebuild(charge.position, charge.radius, false);
+  for (auto _ : state) {
+    list.rebuild(charge.position, charge.radius, false);
+    benchmark::DoNotOptimize(list.pair_count());
+  }
+  state.counters["dimension"] = D;
+  state.counters["particles"] = static_cast<double>(charge.position.size());
+  state.counters["pairs"] = static_cast<double>(list.pair_count());
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(charge.position.size()));
+}
+
+void neighbour_rebuild(benchmark::State& state) {
+  if (const auto* discs = std::get_if<Charge<2>>(&the_charge)) {
+    rebuild_list(state, *discs);
+  } else if (const auto* balls = std::get_if<Charge<3>>(&the_charge)) {
+    rebuild_list(state, *balls);
+  } else {
+    state.SkipWithError("no charge");
+  }
+}
+BENCHMARK(neighbour_rebuild)
+    ->Arg(1)
+    ->Arg(2)
+    ->ArgName("threads")
+    ->UseRealTime()
+    ->Unit(benchmark::kMicrosecond);
+
+/// This program's own flags, taken out of argv (Google Benchmark reads the rest).
+struct Options {
+  std::string config = MILLSIM_SOURCE_DIR "/bench/sag-12m-2d.toml";
+  std::vector<std::string> overrides;
+  double settle_seconds = -1.0;  // < 0: the config's settle_time
+};
+
+Options take_options(int& argc, char** argv) {
+  Options options;
+  int kept = 1;
+  for (int a = 1; a < argc; ++a) {
+    const std::string_view argument = argv[a];
+    const auto value = [&](std::string_view flag) -> const char* {
+      if (a + 1 >= argc) throw millsim::InputError(fmt::format("{} needs a value", flag));
+      return argv[++a];
+    };
+    if (argument == "--help" || argument == "-h") {
+      std::puts(
+          "millsim_micro_bench: one stage of the step at a time on a settled charge\n"
+          "  --config FILE         mill config (TOML; default: bench/sag-12m-2d.toml)\n"
+          "  --set KEY=VALUE       override a config key (repeatable)\n"
+          "  --settle-seconds S    settle the charge for S s of mill time (default: the config's\n"
+          "                        settle_time; 0: time it as placed)\n"
+          "and Google Benchmark's flags:");
+      argv[kept++] = argv[a];  // Google Benchmark's help follows
+    } else if (argument == "--config") {
+      options.config = value(argument);
+    } else if (argument == "--set") {
+      options.overrides.emplace_back(value(argument));
+    } else if (argument == "--settle-seconds") {
+      const std::string text = value(argument);
+      char* end = nullptr;
+      options.settle_seconds = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0' || !(options.settle_seconds >= 0.0)) {
+        throw millsim::InputError(
+            fmt::format("--settle-seconds must be a number of seconds >= 0, not '{}'", text));
+      }
+    } else {
+      argv[kept++] = argv[a];
+    }
+  }
+  argc = kept;
+  return options;
+}
+
+int run(int argc, char** argv) {
+  try {
+    const Options options = take_options(argc, argv);
+    // Google Benchmark's flags read (its --help printed, or an unknown flag refused) before
+    // the charge settles.
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
+    const millsim::MillPlan plan =
+        millsim::plan_mill(millsim::load_mill_config(options.config, options.overrides));
+    const double settle =
+        options.settle_seconds >= 0.0 ? options.settle_seconds : plan.config.settle_time;
+    if (plan.config.dimension == 2) {
+      the_charge = settled_charge<2>(plan, settle);
+    } else {
+      the_charge = settled_charge<3>(plan, settle);
+    }
+  } catch (const millsim::InputError& error) {
+    fmt::print(stderr, "millsim_micro_bench: error: {}\n", error.what());
+    return 2;
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "millsim_micro_bench: failed: %s\n", error.what());
+  }
+  return 1;
+}
