@@ -7,12 +7,15 @@
 //                       --benchmark_repetitions=N]
 //
 // The charge is the config's mill (default: the 2D SAG scene, bench/sag-12m-2d.toml) settled
-// for the config's settle_time, or S seconds of mill time (0: as placed).
+// for the config's settle_time, or S seconds of mill time (0: as placed, after the one step
+// that chooses the skin).
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 #include <omp.h>
 
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -25,16 +28,18 @@
 #include "millsim/io/config.hpp"
 #include "millsim/search/neighbour_list.hpp"
 #include "millsim/sim/charge.hpp"
+#include "millsim/sim/world_detail.hpp"
 
 namespace {
 
-/// What the benchmarks start from: the settled charge's positions and radii, and the skin the
-/// world chose at its last rebuild.
+/// What the benchmarks start from: the settled charge's positions and radii, the skin the
+/// world chose at its last rebuild, and the period of a periodic slab's axis (0: none).
 template <int D>
 struct Charge {
   std::vector<millsim::Vec<D>> position;
   std::vector<double> radius;
   double skin = 0.0;
+  double period = 0.0;
 };
 
 template <int D>
@@ -42,22 +47,30 @@ Charge<D> settled_charge(const millsim::MillPlan& plan, double settle_seconds) {
   millsim::World<D> world = millsim::build_mill_world<D>(plan);
   while (world.time() < settle_seconds) world.step();
   if (world.neighbour_rebuilds() == 0) world.step();  // a skin chosen for this charge
-  return {world.particles().position, world.particles().radius, world.neighbour_skin()};
+  double period = 0.0;
+  if constexpr (D == 3) {
+    const auto& mill = world.walls().mill;
+    if (mill && mill->periodic) period = mill->length;  // as World sets its list's
+  }
+  return {world.particles().position, world.particles().radius, world.neighbour_skin(), period};
 }
 
 /// The charge the benchmarks time: settled in main before they run.
 std::variant<std::monostate, Charge<2>, Charge<3>> the_charge;
 
 /// A rebuild of the charge's list, the particles where they are (the histories carried from
-/// the list before, which holds the same pairs) and not renumbered: NeighbourList::rebuild
-/// as World calls it between cell orderings. state.range(0): the threads.
+/// the list before, which holds the same pairs) and not renumbered: NeighbourList::rebuild as
+/// World calls it between cell orderings, on as many threads (state.range(0)) and asked to run
+/// on them where World would be, but with the particles shared evenly among them (World shares
+/// them as its step's runs).
 template <int D>
 void rebuild_list(benchmark::State& state, const Charge<D>& charge) {
   const int threads = static_cast<int>(state.range(0));
   omp_set_num_threads(threads);
   millsim::NeighbourList<D> list(charge.skin);
-  list.set_parallel(threads > 1);
+  list.set_period(charge.period);
   list.rebuild(charge.position, charge.radius, false);
+  list.set_parallel(millsim::world_detail::splits_among_threads(list.pair_count(), threads));
   for (auto _ : state) {
     list.rebuild(charge.position, charge.radius, false);
     benchmark::DoNotOptimize(list.pair_count());
@@ -84,6 +97,21 @@ BENCHMARK(neighbour_rebuild)
     ->UseRealTime()
     ->Unit(benchmark::kMicrosecond);
 
+/// --help: this program's flags, then Google Benchmark's.
+void print_help() {
+  std::puts(
+      "millsim_micro_bench: one stage of the step at a time on a settled charge\n"
+      "  --config FILE         mill config (TOML; default: bench/sag-12m-2d.toml)\n"
+      "  --set KEY=VALUE       override a config key (repeatable)\n"
+      "  --settle-seconds S    settle the charge for S s of mill time (default: the config's\n"
+      "                        settle_time; 0: as placed, after the one step that chooses the\n"
+      "                        skin)\n"
+      "and Google Benchmark's flags:");
+  benchmark::PrintDefaultHelp();
+}
+
+std::string help_flag = "--help";
+
 /// This program's own flags, taken out of argv (Google Benchmark reads the rest).
 struct Options {
   std::string config = MILLSIM_SOURCE_DIR "/bench/sag-12m-2d.toml";
@@ -96,30 +124,34 @@ Options take_options(int& argc, char** argv) {
   int kept = 1;
   for (int a = 1; a < argc; ++a) {
     const std::string_view argument = argv[a];
-    const auto value = [&](std::string_view flag) -> const char* {
+    // FLAG=VALUE's value, or the next argument.
+    const auto value = [&](std::string_view flag) -> std::string {
+      if (const auto equals = flag.find('='); equals != std::string_view::npos) {
+        return std::string(flag.substr(equals + 1));
+      }
       if (a + 1 >= argc) throw millsim::InputError(fmt::format("{} needs a value", flag));
       return argv[++a];
     };
-    if (argument == "--help" || argument == "-h") {
-      std::puts(
-          "millsim_micro_bench: one stage of the step at a time on a settled charge\n"
-          "  --config FILE         mill config (TOML; default: bench/sag-12m-2d.toml)\n"
-          "  --set KEY=VALUE       override a config key (repeatable)\n"
-          "  --settle-seconds S    settle the charge for S s of mill time (default: the config's\n"
-          "                        settle_time; 0: time it as placed)\n"
-          "and Google Benchmark's flags:");
-      argv[kept++] = argv[a];  // Google Benchmark's help follows
-    } else if (argument == "--config") {
+    // Each of this program's flags as FLAG VALUE or FLAG=VALUE.
+    const auto is = [&](std::string_view flag) {
+      return argument == flag ||
+             (argument.size() > flag.size() && argument.substr(0, flag.size()) == flag &&
+              argument[flag.size()] == '=');
+    };
+    if (argument == "-h") {
+      argv[kept++] = help_flag.data();  // Google Benchmark knows only --help
+    } else if (is("--config")) {
       options.config = value(argument);
-    } else if (argument == "--set") {
+    } else if (is("--set")) {
       options.overrides.emplace_back(value(argument));
-    } else if (argument == "--settle-seconds") {
+    } else if (is("--settle-seconds")) {
       const std::string text = value(argument);
       char* end = nullptr;
       options.settle_seconds = std::strtod(text.c_str(), &end);
-      if (end == text.c_str() || *end != '\0' || !(options.settle_seconds >= 0.0)) {
-        throw millsim::InputError(
-            fmt::format("--settle-seconds must be a number of seconds >= 0, not '{}'", text));
+      if (end == text.c_str() || *end != '\0' || !std::isfinite(options.settle_seconds) ||
+          options.settle_seconds < 0.0) {
+        throw millsim::InputError(fmt::format(
+            "--settle-seconds must be a finite number of seconds >= 0, not '{}'", text));
       }
     } else {
       argv[kept++] = argv[a];
@@ -134,8 +166,11 @@ int run(int argc, char** argv) {
     const Options options = take_options(argc, argv);
     // Google Benchmark's flags read (its --help printed, or an unknown flag refused) before
     // the charge settles.
-    benchmark::Initialize(&argc, argv);
-    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
+    benchmark::Initialize(&argc, argv, print_help);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) {
+      std::fputs("millsim_micro_bench: see --help for the flags allowed\n", stderr);
+      return 2;
+    }
     const millsim::MillPlan plan =
         millsim::plan_mill(millsim::load_mill_config(options.config, options.overrides));
     const double settle =
@@ -161,6 +196,8 @@ int main(int argc, char** argv) {
     return run(argc, argv);
   } catch (const std::exception& error) {
     std::fprintf(stderr, "millsim_micro_bench: failed: %s\n", error.what());
+  } catch (...) {
+    std::fputs("millsim_micro_bench: failed: an unknown error\n", stderr);
   }
   return 1;
 }
