@@ -46,7 +46,7 @@ build=${MILLSIM_BUILD:-build/release}
 if [ -z "${MILLSIM_BUILD:-}" ]; then
   bash scripts/install-deps.sh
   cmake --preset release >/dev/null
-  cmake --build --preset release --target millsim_scene_bench >/dev/null
+  cmake --build --preset release --target millsim millsim_scene_bench >/dev/null
 fi  # a given MILLSIM_BUILD is used as it is (not rebuilt)
 bench="$build/bench/millsim_scene_bench"
 
