@@ -511,9 +511,8 @@ class World {
   };
   IntegrationArrays integration_arrays();
   /// Its loop over particles [begin, end), for a periodic slab or not. Processors with AVX2 run
-  /// a second version, the same bits either way (integrate_particles_avx2): in 2D the loop
-  /// without a period compiled again (two discs in a register, where the other works on one),
-  /// in 3D four spheres at a time, periodic or not.
+  /// a second version, the same bits either way (integrate_particles_avx2): in 2D four discs at
+  /// a time (a 2D world is never periodic), in 3D four spheres at a time, periodic or not.
   template <bool periodic>
   [[gnu::always_inline]] inline bool integrate_particles(std::size_t begin, std::size_t end);
   __attribute__((target("avx2"))) bool integrate_particles_avx2(std::size_t begin, std::size_t end);
