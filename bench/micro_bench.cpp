@@ -14,13 +14,13 @@
 #include <fmt/format.h>
 #include <omp.h>
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <string>
-#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -97,80 +97,49 @@ BENCHMARK(neighbour_rebuild)
     ->UseRealTime()
     ->Unit(benchmark::kMicrosecond);
 
-/// --help: this program's flags, then Google Benchmark's.
-void print_help() {
-  std::puts(
-      "millsim_micro_bench: one stage of the step at a time on a settled charge\n"
-      "  --config FILE         mill config (TOML; default: bench/sag-12m-2d.toml)\n"
-      "  --set KEY=VALUE       override a config key (repeatable)\n"
-      "  --settle-seconds S    settle the charge for S s of mill time (default: the config's\n"
-      "                        settle_time; 0: as placed, after the one step that chooses the\n"
-      "                        skin)\n"
-      "and Google Benchmark's flags:");
-  benchmark::PrintDefaultHelp();
-}
-
-std::string help_flag = "--help";
-
-/// This program's own flags, taken out of argv (Google Benchmark reads the rest).
+/// This program's own flags (CLI11); the others go to Google Benchmark.
 struct Options {
   std::string config = MILLSIM_SOURCE_DIR "/bench/sag-12m-2d.toml";
   std::vector<std::string> overrides;
   double settle_seconds = -1.0;  // < 0: the config's settle_time
 };
 
-Options take_options(int& argc, char** argv) {
-  Options options;
-  int kept = 1;
-  for (int a = 1; a < argc; ++a) {
-    const std::string_view argument = argv[a];
-    // FLAG=VALUE's value, or the next argument.
-    const auto value = [&](std::string_view flag) -> std::string {
-      if (const auto equals = flag.find('='); equals != std::string_view::npos) {
-        return std::string(flag.substr(equals + 1));
-      }
-      if (a + 1 >= argc) throw millsim::InputError(fmt::format("{} needs a value", flag));
-      return argv[++a];
-    };
-    // Each of this program's flags as FLAG VALUE or FLAG=VALUE.
-    const auto is = [&](std::string_view flag) {
-      return argument == flag ||
-             (argument.size() > flag.size() && argument.substr(0, flag.size()) == flag &&
-              argument[flag.size()] == '=');
-    };
-    if (argument == "-h") {
-      argv[kept++] = help_flag.data();  // Google Benchmark knows only --help
-    } else if (is("--config")) {
-      options.config = value(argument);
-    } else if (is("--set")) {
-      options.overrides.emplace_back(value(argument));
-    } else if (is("--settle-seconds")) {
-      const std::string text = value(argument);
-      char* end = nullptr;
-      options.settle_seconds = std::strtod(text.c_str(), &end);
-      if (end == text.c_str() || *end != '\0' || !std::isfinite(options.settle_seconds) ||
-          options.settle_seconds < 0.0) {
-        throw millsim::InputError(fmt::format(
-            "--settle-seconds must be a finite number of seconds >= 0, not '{}'", text));
-      }
-    } else {
-      argv[kept++] = argv[a];
-    }
-  }
-  argc = kept;
-  return options;
-}
-
 int run(int argc, char** argv) {
+  CLI::App app{"millsim_micro_bench: one stage of the step at a time on a settled charge"};
+  Options options;
+  app.add_option("--config", options.config, "mill config (TOML)")->capture_default_str();
+  app.add_option("--set", options.overrides, "override a config key (repeatable)");
+  app.add_option("--settle-seconds", options.settle_seconds,
+                 "settle the charge for this many seconds of mill time (default: the config's "
+                 "settle_time; 0: as placed, after the one step that chooses the skin)")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            char* end = nullptr;
+            const double seconds = std::strtod(text.c_str(), &end);
+            const bool allowed =
+                end != text.c_str() && *end == '\0' && std::isfinite(seconds) && seconds >= 0.0;
+            return allowed ? "" : "must be a finite number of seconds >= 0, not '" + text + "'";
+          },
+          "SECONDS >= 0"));
+  app.allow_extras();
+  app.footer(
+      "Other flags go to Google Benchmark: --benchmark_filter=REGEX, "
+      "--benchmark_repetitions=N, --benchmark_min_time=SECONDS, "
+      "--benchmark_format=console|json|csv, --benchmark_out=FILE, ...");
+  CLI11_PARSE(app, argc, argv);
+  // Google Benchmark's flags read (an unknown flag refused) before the charge settles.
+  std::vector<std::string> passed{argv[0]};
+  for (const std::string& flag : app.remaining()) passed.push_back(flag);
+  std::vector<char*> passed_argv;
+  passed_argv.reserve(passed.size());
+  for (std::string& flag : passed) passed_argv.push_back(flag.data());
+  int passed_argc = static_cast<int>(passed_argv.size());
+  benchmark::Initialize(&passed_argc, passed_argv.data());
+  if (benchmark::ReportUnrecognizedArguments(passed_argc, passed_argv.data())) {
+    std::fputs("millsim_micro_bench: see --help for the flags allowed\n", stderr);
+    return 2;
+  }
   try {
-    const Options options = take_options(argc, argv);
-    // Google Benchmark's flags read (its --help printed, or an unknown flag refused) before
-    // the charge settles.
-    benchmark::Initialize(&argc, argv, print_help);
-    if (benchmark::ReportUnrecognizedArguments(argc, argv)) {
-      std::fputs("millsim_micro_bench: see --help for the flags allowed\n", stderr);
-      return 2;
-    }
     const millsim::MillPlan plan =
         millsim::plan_mill(millsim::load_mill_config(options.config, options.overrides));
     const double settle =
