@@ -210,6 +210,25 @@ TEST(ConicalMillWall, SphereAgainstALifterEndInTheConeTouchesTheBarsEndFace) {
                   "lifter end face");
 }
 
+TEST(ConicalMillWall, SphereCentredAHairBeyondALifterEndHasAFiniteAxialNormal) {
+  // The same sphere with its centre next to nothing beyond the bar's end face (z = −1e-100 m,
+  // −1e-160 m: the distance's square is 0 in doubles) touches the face along −z with overlap
+  // r; its normal was once axial / (r − overlap) = axial / 0, infinite.
+  const Mill3D mill = conical_mill(0.0, 1.5, lifter_count, 80.0 * pi / 180.0);
+  for (const double z : {-1e-100, -1e-160}) {
+    WallContact<3> found[max_mill_contacts<3>];
+    const int count = mill_contacts(mill, Vec3{{0.415, 0.0, z}}, ball_radius, found);
+    const auto lifter = std::find_if(
+        found, found + count, [](const WallContact<3>& c) { return c.kind == WallKind::lifter; });
+    ASSERT_NE(lifter, found + count) << "z = " << z;
+    EXPECT_EQ(lifter->wall_id, 1) << "z = " << z;
+    EXPECT_EQ(lifter->normal[0], 0.0) << "z = " << z;
+    EXPECT_EQ(lifter->normal[1], 0.0) << "z = " << z;
+    EXPECT_EQ(lifter->normal[2], -1.0) << "z = " << z;
+    EXPECT_DOUBLE_EQ(lifter->overlap, ball_radius) << "z = " << z;
+  }
+}
+
 /// Distance in the meridian plane from (ρ, s) to the segment from p to q, found by ternary
 /// search on the squared distance along it (convex in the parameter): a brute-force answer
 /// independent of the closest-point algebra.

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -284,6 +285,68 @@ TEST(MillWall, DiscJustClearOfALifterHasNoContact) {
 }
 
 // ---- Determinism ---------------------------------------------------------------------------
+
+/// Distance from `centre` to lifter k's bar, worked out directly: the bar spans R − h to
+/// R + h along its middle (it reaches past the shell) and ±w/2 across.
+double distance_to_lifter(const Mill2D& mill, int k, const Vec2& centre) {
+  const double angle = mill.angle + 2.0 * pi * k / mill.lifter_count;
+  const double along = centre[0] * std::cos(angle) + centre[1] * std::sin(angle);
+  const double across = -centre[0] * std::sin(angle) + centre[1] * std::cos(angle);
+  const double outside_along =
+      along - std::clamp(along, mill.radius - mill.lifter_height, mill.radius + mill.lifter_height);
+  const double outside_across =
+      across - std::clamp(across, -0.5 * mill.lifter_width, 0.5 * mill.lifter_width);
+  return std::hypot(outside_along, outside_across);
+}
+
+TEST(MillWall, EveryLifterADiscTouchesIsFoundWhileLiftersTwoApartStandADiameterApart) {
+  // The contact search tests the lifter nearest a disc and its two neighbours; plan_mill refuses
+  // mills whose lifters two apart stand closer than the largest ball. At that limit (the disc's
+  // diameter the distance), discs anywhere in the mill, most of them against the lifters: every
+  // lifter a disc overlaps is among its contacts. Mills of few tall lifters (near the axis they
+  // converge) and of many small ones.
+  struct Case {
+    int count;
+    double height, width;
+  };
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (const Case c : {Case{4, 0.3, 0.05}, Case{5, 0.25, 0.1}, Case{8, 0.04, 0.04},
+                       Case{60, 0.1, 0.02}, Case{200, 0.02, 0.01}}) {
+    Mill2D mill;
+    mill.radius = 0.5;
+    mill.lifter_count = c.count;
+    mill.lifter_height = c.height;
+    mill.lifter_width = c.width;
+    mill.turn_to(0.3);
+    const double diameter =
+        distance_between_lifters_two_apart(mill.radius, c.count, c.height, c.width);
+    ASSERT_GT(diameter, 0.0);
+    const double r = 0.5 * diameter;
+    long touching = 0;
+    for (int trial = 0; trial < 100000; ++trial) {
+      // Half the discs within a radius of the lifters' inner faces, the rest anywhere inside.
+      const double phi = 2.0 * pi * unit(random);
+      const double inner = mill.radius - c.height;
+      const double rho = trial % 2 == 0 ? std::max(0.0, inner - r + 2.0 * r * unit(random))
+                                        : (mill.radius - r) * std::sqrt(unit(random));
+      const Vec2 centre{{rho * std::cos(phi), rho * std::sin(phi)}};
+      WallContact<2> found[8];
+      const int n = mill_contacts(mill, centre, r, found);
+      for (int k = 0; k < c.count; ++k) {
+        if (distance_to_lifter(mill, k, centre) >= r) continue;
+        ++touching;
+        const bool listed = std::any_of(found, found + n, [&](const WallContact<2>& contact) {
+          return contact.wall_id == 1 + k;
+        });
+        ASSERT_TRUE(listed) << c.count << " lifters: the disc of radius " << r << " at ("
+                            << centre[0] << ", " << centre[1] << ") touches lifter " << k
+                            << ", not among its " << n << " contacts";
+      }
+    }
+    EXPECT_GT(touching, 10000) << c.count << " lifters: too few discs touched one";
+  }
+}
 
 TEST(MillWall, TheExampleMillRunsBitForBitTheSameTwice) {
   // The built-in example (75 discs, eight lifters), short: 1500 steps with the shell still (the

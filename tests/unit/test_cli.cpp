@@ -304,6 +304,24 @@ TEST_F(Cli, RefusesASlabTooShortForItsBalls) {
                   "mill, mill.periodic = false)"});
 }
 
+TEST_F(Cli, RefusesLiftersSoCloseThatABallCouldTouchOneBeyondTheNeighbours) {
+  // The contact search tests the nearest lifter and its two neighbours: lifters two apart must
+  // stand a largest ball diameter apart. 70 lifters 0.1 m high and 0.02 m wide in the 0.9 m
+  // mill: their facing inner corners, at 0.3506 m from the axis and 0.02856 rad off each
+  // lifter's middle, are 2 (0.3506) sin(4π/140 − 0.02856) = 0.04283 m apart, less than 0.0508 m.
+  const std::string dense =
+      with(with(with(base_config, "count", "count = 70"), "height", "height = 0.1"), "width",
+           "width = 0.02");
+  expect_refused(run_config(dense),
+                 {at_line(dense, "count"), "mill.lifters.count", "0.04283 m apart",
+                  "less than the largest ball, 0.0508 m",
+                  "allowed: fewer, lower or narrower lifters, or smaller balls"});
+  // 60 of them stand 0.0533 m apart: accepted.
+  const std::string fewer = with(dense, "count = 70", "count = 60");
+  const Outcome accepted = run_config(fewer, tiny_run);
+  EXPECT_EQ(accepted.status, 0) << accepted.err;
+}
+
 TEST_F(Cli, InfoOfAConicalMillPrintsItsCones) {
   // examples/conical-mill-3d.toml: 20°, 0.1 m cones on a 0.9 m mill, r_t = 0.45 − 0.1 / tan 20°.
   const Outcome info =

@@ -12,9 +12,11 @@ namespace {
 /// b ∈ [−w/2, w/2] (the part beyond the shell, a > R, is out of reach and only closes the
 /// shape) and, with end plates, z ∈ [0, L]. Clamping each coordinate to the bar gives the
 /// closest point on a face, an edge or a corner, whichever it is. `axial` is the particle's
-/// distance along z from the bar (0 when it is beside it or the mill is periodic).
+/// distance along z from the bar (0 when it is beside it or the mill is periodic); the normal's
+/// component along it, axial / distance, goes to `axial_normal` if given.
 bool lifter_contact(const Mill2D& mill, int index, const Vec2& planar_centre, double axial,
-                    double particle_radius, WallContact<2>& contact) {
+                    double particle_radius, WallContact<2>& contact,
+                    double* axial_normal = nullptr) {
   const Vec2 radial = mill.lifter_direction[static_cast<std::size_t>(index)];
   const Vec2 tangential{{-radial[1], radial[0]}};
   const double a = dot(planar_centre, radial);
@@ -38,8 +40,12 @@ bool lifter_contact(const Mill2D& mill, int index, const Vec2& planar_centre, do
     normal_a /= distance;
     normal_b /= distance;
     contact.overlap = particle_radius - distance;
+    if (axial_normal != nullptr) *axial_normal = axial / distance;
   } else if (axial > 0.0) {
+    // Beyond the bar's end, level with its end face: the normal is along the axis (whatever the
+    // rounding of a distance next to nothing, whose square may be 0).
     contact.overlap = particle_radius - distance;
+    if (axial_normal != nullptr) *axial_normal = 1.0;
   } else {
     // Centre inside the bar (only after a violent step): push out through the nearest face.
     const double to_inner_face = a - inner;
@@ -85,7 +91,8 @@ double approximate_atan2(double y, double x) {
 }
 
 /// The lifters a particle at `planar_centre` may touch: the one nearest to it by angle and
-/// that lifter's two neighbours (any lifter further round lies behind one of those). Calls
+/// that lifter's two neighbours (any lifter further round lies behind one of those, for
+/// particles no wider than distance_between_lifters_two_apart, which plan_mill checks). Calls
 /// visit(index) for each. The nearest one is found from an approximate angle: it can differ
 /// from the exact one's only for a centre within 2e-8 rad of half-way between two lifters,
 /// which then touches neither of the two lifters beyond them that the choice decides between.
@@ -238,6 +245,19 @@ void Mill2D::turn_to(double new_angle) {
   }
 }
 
+double distance_between_lifters_two_apart(double radius, int count, double height, double width) {
+  // The inner corner of lifter k towards lifter k + 2, (R − h, w/2) in k's frame, is at
+  // distance ρ = hypot(R − h, w/2) from the axis and angle β = atan(w/2 / (R − h)) off k's
+  // middle; k + 2's facing corner is its mirror image about the line half-way between them,
+  // 4π/n round. The two chords between them span 4π/n − 2β. Other points of the bars are
+  // further apart: the sides and inner faces turn away from each other (4π/n ≤ π).
+  const double inner = radius - height;
+  const double half_width = 0.5 * width;
+  const double corner_radius = std::hypot(inner, half_width);
+  const double corner_angle = std::atan2(half_width, inner);
+  return 2.0 * corner_radius * std::sin(2.0 * pi / count - corner_angle);
+}
+
 NearbyLifters nearby_lifters(const Mill2D& mill, const Vec2& planar_centre, double reach) {
   NearbyLifters nearby;
   const int lifters = mill.lifter_count;
@@ -300,10 +320,14 @@ int mill_contacts(const Mill3D& mill, const Vec3& centre, double particle_radius
     const double bar_z = mill.periodic ? z : std::clamp(z, 0.0, mill.length);
     const double axial = z - bar_z;
     for_each_lifter_to_test(mill, planar, nearby, [&](int index) {
-      if (!lifter_contact(mill, index, planar, std::abs(axial), particle_radius, found)) return;
+      double axial_normal = 0.0;
+      if (!lifter_contact(mill, index, planar, std::abs(axial), particle_radius, found,
+                          &axial_normal)) {
+        return;
+      }
       WallContact<3>& contact = out[count++];
       extrude(found, bar_z, contact);
-      if (axial != 0.0) contact.normal[2] = axial / (particle_radius - found.overlap);
+      if (axial != 0.0) contact.normal[2] = axial < 0.0 ? -axial_normal : axial_normal;
     });
   }
   if (mill.has_cones()) {

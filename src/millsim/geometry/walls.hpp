@@ -92,6 +92,16 @@ struct NearbyLifters {
 /// is among those within r + d + s. In mill_geometry.cpp.
 NearbyLifters nearby_lifters(const Mill2D& mill, const Vec2& planar_centre, double reach);
 
+/// The distance between two lifters with one between them (lifters k and k + 2 of `count`
+/// ≥ 4 lifters of the given height and width in a shell of `radius`): the distance between
+/// their facing inner corners, which are the closest points of the two bars. The contact search
+/// tests the lifter nearest a particle and its two neighbours (mill_contacts); it finds every
+/// lifter a particle touches as long as the particle's diameter is at most this distance, which
+/// plan_mill checks for the largest ball (a particle's distance to a lifter grows with the angle
+/// between them, so one touching a lifter beyond those three would touch the nearest one as
+/// well, and so two lifters this far apart). In mill_geometry.cpp.
+double distance_between_lifters_two_apart(double radius, int count, double height, double width);
+
 /// An infinite plane (a line in 2D): the particle side is where (x − point)·normal > 0.
 template <int D>
 struct Plane {
