@@ -188,6 +188,8 @@ int run_scene_command(const millsim::SceneConfig& scene, const JobOptions& optio
   const millsim::SceneResult result = millsim::run_scene(
       plan, out, [&](double time, double total) { progress(time, total, -1.0); });
   progress.clear();
+  warn(millsim::scene_result_warnings(result),
+       fmt::format("results in {}/", scene.output_directory));
   fmt::print("{}\n", millsim::scene_summary_line(result));
   if (!options.quiet) {
     fmt::print("results in {}/ (summary.json, trajectory.csv, final.csv)\n",

@@ -457,6 +457,12 @@ std::vector<std::string> result_warnings(const MillResult& r) {
                          : "its energy changed over the window: run more revolutions before "
                            "measuring, or measure more"));
   }
+  if (r.dropped_wall_contacts > 0) {
+    warnings.push_back(fmt::format(
+        "{} wall contacts were left out (a particle pressed into more walls at once than millsim "
+        "keeps a contact history for): the results are doubtful",
+        r.dropped_wall_contacts));
+  }
   if (r.largest_overlap_fraction > doubtful_overlap_fraction) {
     warnings.push_back(fmt::format(
         "contacts overlapped by up to {:.0f} % of the smaller ball's radius (more than {:.0f} %): "

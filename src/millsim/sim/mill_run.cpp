@@ -197,6 +197,7 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
   }
 
   result.steps = world.steps();
+  result.dropped_wall_contacts = world.dropped_wall_contacts();
   result.simulated_seconds = world.time();
   result.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

@@ -118,6 +118,7 @@ std::string summary_json(const SceneResult& r) {
       {"dissipated_j", number(r.dissipated)},
       {"ball_ball_collisions", whole(r.ball_ball_collisions)},
       {"ball_wall_collisions", whole(r.ball_wall_collisions)},
+      {"dropped_wall_contacts", whole(r.dropped_wall_contacts)},
   };
   // A scene whose particles can touch nothing has neither (the plan holds 0 for them).
   if (r.plan.shortest_contact > 0.0) {
@@ -288,6 +289,7 @@ SceneResult run_scene_in(const ScenePlan& plan, const std::filesystem::path& dir
   result.dissipated = world.energy_account().dissipated;
   result.ball_ball_collisions = spectrum.total_count(ContactType::ball_ball);
   result.ball_wall_collisions = spectrum.total_count(ContactType::ball_plane);
+  result.dropped_wall_contacts = world.dropped_wall_contacts();
 
   const std::string summary_text = summary_json(result);  // throws before anything is kept
   trajectory.commit();
@@ -296,6 +298,18 @@ SceneResult run_scene_in(const ScenePlan& plan, const std::filesystem::path& dir
   summary.write(summary_text);
   summary.commit();
   return result;
+}
+
+std::vector<std::string> scene_result_warnings(const SceneResult& result) {
+  if (result.dropped_wall_contacts == 0) return {};
+  const int most =
+      result.plan.config.dimension == 2 ? World<2>::max_wall_contacts : World<3>::max_wall_contacts;
+  return {fmt::format(
+      "{} wall contacts were left out (the force of a wall a particle overlapped, for a step "
+      "each): a particle pressed into more than {} walls at once, the most millsim keeps a "
+      "contact history for; the results are doubtful where walls meet so closely (planes "
+      "nearly parallel, or more than {} through one corner)",
+      result.dropped_wall_contacts, most, most)};
 }
 
 SceneResult run_scene(const ScenePlan& plan, const std::filesystem::path& directory,

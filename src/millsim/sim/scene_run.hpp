@@ -48,6 +48,7 @@ struct SceneResult {
   double dissipated = 0.0;                            ///< J
   long ball_ball_collisions = 0;                      ///< collisions that ended during the run
   long ball_wall_collisions = 0;
+  long dropped_wall_contacts = 0;  ///< World::dropped_wall_contacts at the end
 };
 
 /// Called now and then with (simulated time, duration).
@@ -57,6 +58,9 @@ using SceneProgress = std::function<void(double, double)>;
 /// must exist). Files are written under a temporary name and renamed when complete.
 SceneResult run_scene(const ScenePlan& plan, const std::filesystem::path& directory,
                       const SceneProgress& progress = {});
+
+/// What makes the results doubtful: wall contacts left out (World::dropped_wall_contacts).
+std::vector<std::string> scene_result_warnings(const SceneResult& result);
 
 /// The one-line summary printed at the end of a scene run.
 std::string scene_summary_line(const SceneResult& result);

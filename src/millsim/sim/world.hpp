@@ -224,6 +224,12 @@ class World {
   double last_step_dissipation() const { return last_step_dissipation_; }
   long neighbour_rebuilds() const { return neighbours_.rebuild_count(); }
   std::size_t touching_contacts() const;
+  /// Wall contacts left out since the world was made because every one of the particle's
+  /// max_wall_contacts slots of wall-contact history held another wall: a particle pressed
+  /// into more walls at once than that (five or more of a scene's planes in 2D, say). A mill's
+  /// particles cannot touch so many (its lifters are refused closer than a ball can reach
+  /// across: plan_mill). The runs warn of any.
+  long dropped_wall_contacts() const { return dropped_wall_contacts_; }
   /// Particles that may touch a wall before the next neighbour-list rebuild.
   std::size_t wall_candidate_count() const { return wall_candidates_.size(); }
   /// Pairs per block of the pair stage, and wall candidates per block of the wall stage: the
@@ -663,6 +669,7 @@ class World {
   // nearby_lifter_angle_ (refresh_nearby_lifters).
   bool nearby_lifter_lists_ = true;
   bool avx2_lanes_ = false;
+  long dropped_wall_contacts_ = 0;  // (added to by the threads' wall stages, atomically)
   /// Whether the step prefetches what it will read out of memory order (the pair kernel's
   /// prefetch_pairs, the one-pair-at-a-time first pass, the wall slots' histories, the 3D
   /// integration): set at each rebuild from the size of the particle arrays (above 1 MiB).

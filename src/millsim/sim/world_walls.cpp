@@ -113,6 +113,7 @@ void World<D>::evaluate_wall_candidates(std::size_t b, std::size_t begin, std::s
   const bool quick =
       !nearby_lifters_.empty() && walls_.planes.empty() && walls_.mill && !mill_has_cones();
   const double shell_radius = walls_.mill ? walls_.mill->radius : 0.0;
+  long dropped = 0;  // contacts with no free slot (dropped_wall_contacts)
   for (std::size_t k = begin; k < end; ++k) {
     const std::uint32_t i = wall_candidates_[k];
     std::int32_t* slot_id = &wall_slot_id_[k * max_wall_contacts];
@@ -142,7 +143,10 @@ void World<D>::evaluate_wall_candidates(std::size_t b, std::size_t begin, std::s
       if (slot == max_wall_contacts) {
         slot = 0;
         while (slot < max_wall_contacts && slot_id[slot] >= 0) ++slot;
-        if (slot == max_wall_contacts) continue;  // cannot happen: see max_wall_contacts
+        if (slot == max_wall_contacts) {
+          ++dropped;  // more walls at once than slots: see dropped_wall_contacts()
+          continue;
+        }
         slot_id[slot] = wall_id;
         // A collision begins: where, for ShellImpacts (its history is fresh, all zero).
         history_at(slot).start_angle = std::atan2(contact[c].point[1], contact[c].point[0]);
@@ -173,6 +177,10 @@ void World<D>::evaluate_wall_candidates(std::size_t b, std::size_t begin, std::s
       history_at(slot) = WallHistory{};
       slot_id[slot] = -1;
     }
+  }
+  if (dropped > 0) {
+#pragma omp atomic
+    dropped_wall_contacts_ += dropped;
   }
   evaluate_wall_laws(found_list.data(), work_list.data(), found);
   for (std::size_t k = begin; k < end; ++k) {
