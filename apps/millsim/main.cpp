@@ -438,10 +438,31 @@ int validate_command(const std::string& directory, const JobOptions& options) {
     std::optional<double> paper;
   };
   std::vector<Row> rows(plans.size());
-  // The table of an earlier validation goes once the first case's directory is ready (a case
-  // refused there leaves it), before any case runs: a validation that fails half-way leaves no
-  // table from another.
-  bool earlier_table_removed = false;
+  // Every case's earlier results and the earlier table are moved aside before any case runs,
+  // all put back if one cannot be (a refusal clears nothing), then removed: a validation
+  // stopped half-way leaves its own cases' results and nothing of another's (each case once
+  // cleared only its own directory as it started, so an interrupted validation left the cases
+  // not yet run holding the earlier one's results).
+  {
+    std::vector<EarlierResults> aside;
+    try {
+      for (const MillPlan& plan : plans) {
+        const std::filesystem::path out = plan.config.output_directory;
+        std::error_code error;
+        if (!std::filesystem::is_directory(std::filesystem::symlink_status(out, error))) continue;
+        aside.push_back(
+            move_results_aside(out, root_location, mill_result_names, Snapshots::removed));
+      }
+      std::error_code error;
+      if (std::filesystem::is_directory(std::filesystem::symlink_status(root, error))) {
+        aside.push_back(move_results_aside(root, root_location, {"validation.csv"}));
+      }
+    } catch (...) {
+      for (auto back = aside.rbegin(); back != aside.rend(); ++back) (void)back->put_back("");
+      throw;
+    }
+    for (EarlierResults& results : aside) warn(results.remove(), results.location);
+  }
   std::mutex starting;
   // The cases as a sweep's points: as many at a time as there are threads (the small mills
   // gain little from a second thread), a progress line only when they run one at a time.
@@ -451,14 +472,6 @@ int validate_command(const std::string& directory, const JobOptions& options) {
     const MillConfig& config = plan.config;
     const auto started = [&] {
       const std::lock_guard lock(starting);
-      if (!earlier_table_removed) {
-        for (const auto& stale :
-             {table_path, std::filesystem::path(table_path.string() + ".partial")}) {
-          std::error_code ignored;
-          std::filesystem::remove(stale, ignored);
-        }
-        earlier_table_removed = true;
-      }
       if (!options.quiet) fmt::print(stderr, "running {} ...\n", config.source);
     };
     const bool progress = !options.quiet && share.at_a_time <= 1;

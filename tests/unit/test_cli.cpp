@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -913,6 +914,51 @@ TEST_F(Cli, ValidateRefusesWhatWouldTakeTheNameOfItsTableBeforeAnyCaseRuns) {
     EXPECT_FALSE(fs::exists(work_ / "parent" / "runs"));
     EXPECT_EQ(read_all(work_ / "parent" / "snapshots" / "notes.txt"), "kept\n");
     fs::remove(work_ / "cases" / name);
+  }
+}
+
+TEST_F(Cli, AValidationStoppedHalfWayLeavesNothingOfTheOneBefore) {
+  // Three cases run one at a time (-j 1) in the order a, b, c. A first validation of all
+  // three writes their results and the table; a second, whose case b runs for hours, is
+  // stopped (SIGTERM: a background job ignores SIGINT) once a is done: a holds its new results, and
+  // neither c nor the table the earlier validation's (c once kept them, not yet cleared by its own
+  // start).
+  fs::create_directories(work_ / "cases");
+  const auto write_case = [&](const char* name, const char* revolutions) {
+    std::ofstream(work_ / "cases" / (std::string(name) + ".toml"))
+        << with(with(with(with(validation_case(
+                                   fmt::format("case = \"{}\"\nmeasured_power_kw = 0.6\n", name)),
+                               "revolutions", fmt::format("revolutions = {}", revolutions)),
+                          "measure_revolutions", "measure_revolutions = 1\nsettle_time = 0.01"),
+                     "snapshot_interval", "snapshot_interval = 0"),
+                "time_step", "time_step = \"auto\"");
+  };
+  for (const char* name : {"a", "b", "c"}) write_case(name, "1");
+  const Outcome first = millsim("validate cases -q -j 1 -o runs");
+  ASSERT_NE(first.status, 2) << first.err;
+  for (const char* name : {"a", "b", "c"}) {
+    ASSERT_TRUE(fs::exists(work_ / "runs" / name / "summary.json")) << name;
+  }
+  ASSERT_TRUE(fs::exists(work_ / "runs" / "validation.csv"));
+  write_case("b", "100000");
+  // Stopped once a's new summary is written and b's earlier one gone, that is once b runs (at
+  // most two minutes on), whatever the build's speed.
+  const std::string stopped =
+      "cd " + work_.string() + " && { " + std::string(MILLSIM_BINARY) +
+      " validate cases -q -j 1 -o runs >/dev/null 2>&1 & pid=$!; n=0; "
+      "while { [ ! -f runs/a/summary.json ] || [ -f runs/b/summary.json ]; } && [ $n -lt 2400 ] "
+      "&& kill -0 $pid 2>/dev/null; do "
+      "sleep 0.05; n=$((n+1)); done; kill -TERM $pid; wait $pid; }";
+  const int raw = std::system(stopped.c_str());
+  ASSERT_TRUE(WIFEXITED(raw)) << raw;
+  ASSERT_EQ(WEXITSTATUS(raw), 128 + SIGTERM) << "stopped by the signal";
+  EXPECT_TRUE(fs::exists(work_ / "runs" / "a" / "summary.json")) << "a ran again";
+  EXPECT_FALSE(fs::exists(work_ / "runs" / "b" / "summary.json")) << "b was stopped";
+  EXPECT_FALSE(fs::exists(work_ / "runs" / "c" / "summary.json")) << "c's are the earlier ones";
+  EXPECT_FALSE(fs::exists(work_ / "runs" / "c" / "power.csv"));
+  EXPECT_FALSE(fs::exists(work_ / "runs" / "validation.csv"));
+  for (const auto& entry : fs::directory_iterator(work_ / "runs" / "c")) {
+    ADD_FAILURE() << "left in c: " << entry.path();
   }
 }
 
