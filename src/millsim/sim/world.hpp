@@ -669,7 +669,6 @@ class World {
   // nearby_lifter_angle_ (refresh_nearby_lifters).
   bool nearby_lifter_lists_ = true;
   bool avx2_lanes_ = false;
-  long dropped_wall_contacts_ = 0;  // (added to by the threads' wall stages, atomically)
   /// Whether the step prefetches what it will read out of memory order (the pair kernel's
   /// prefetch_pairs, the one-pair-at-a-time first pass, the wall slots' histories, the 3D
   /// integration): set at each rebuild from the size of the particle arrays (above 1 MiB).
@@ -689,6 +688,7 @@ class World {
   double lifter_travel_ = 0.0;
   int nearby_lifter_count_ = 0;
   long nearby_lifter_refreshes_ = 0;
+  long dropped_wall_contacts_ = 0;  // (added to by the threads' wall stages, atomically)
   std::vector<EndedCollision> wall_ended_;  // block b's at [b × wall_block_ × max, ...)
   std::vector<std::uint32_t> wall_block_ended_;
   std::vector<double> wall_block_dissipated_, wall_block_torque_, wall_block_work_;
