@@ -448,13 +448,13 @@ int validate_command(const std::string& directory, const JobOptions& options) {
     try {
       for (const MillPlan& plan : plans) {
         const std::filesystem::path out = plan.config.output_directory;
-        std::error_code error;
-        if (!std::filesystem::is_directory(std::filesystem::symlink_status(out, error))) continue;
+        std::error_code error;  // (a link to a directory is one too)
+        if (!std::filesystem::is_directory(std::filesystem::status(out, error))) continue;
         aside.push_back(
             move_results_aside(out, root_location, mill_result_names, Snapshots::removed));
       }
       std::error_code error;
-      if (std::filesystem::is_directory(std::filesystem::symlink_status(root, error))) {
+      if (std::filesystem::is_directory(std::filesystem::status(root, error))) {
         aside.push_back(move_results_aside(root, root_location, {"validation.csv"}));
       }
     } catch (...) {

@@ -212,8 +212,8 @@ TEST(ConicalMillWall, SphereAgainstALifterEndInTheConeTouchesTheBarsEndFace) {
 
 TEST(ConicalMillWall, SphereCentredAHairBeyondALifterEndHasAFiniteAxialNormal) {
   // The same sphere with its centre next to nothing beyond the bar's end face (z = −1e-100 m,
-  // −1e-160 m: the distance's square is 0 in doubles) touches the face along −z with overlap
-  // r; its normal was once axial / (r − overlap) = axial / 0, infinite.
+  // −1e-160 m) touches the face along −z with overlap r (r − distance rounds to r); its normal
+  // was once axial / (r − overlap) = axial / 0, infinite.
   const Mill3D mill = conical_mill(0.0, 1.5, lifter_count, 80.0 * pi / 180.0);
   for (const double z : {-1e-100, -1e-160}) {
     WallContact<3> found[max_mill_contacts<3>];

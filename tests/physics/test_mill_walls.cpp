@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "millsim/builtin_example.hpp"
@@ -299,52 +300,67 @@ double distance_to_lifter(const Mill2D& mill, int k, const Vec2& centre) {
   return std::hypot(outside_along, outside_across);
 }
 
-TEST(MillWall, EveryLifterADiscTouchesIsFoundWhileLiftersTwoApartStandADiameterApart) {
+/// Discs of `diameter` in `mill`, half of them centred half-way between two lifters (where the
+/// farthest lifters the search leaves out are nearest), the rest anywhere inside: how many
+/// overlap a lifter that is not among their contacts, and how many lifter overlaps there were.
+std::pair<long, long> lifter_contacts_missed(const Mill2D& mill, double diameter,
+                                             std::mt19937_64& random) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double r = 0.5 * diameter;
+  const double spacing = 2.0 * pi / mill.lifter_count;
+  long missed = 0;
+  long touching = 0;
+  for (int trial = 0; trial < 100000; ++trial) {
+    const double phi =
+        trial % 2 == 0 ? mill.angle + spacing * (std::floor(mill.lifter_count * unit(random)) + 0.5)
+                       : 2.0 * pi * unit(random);
+    const double rho =
+        (mill.radius - r) * (trial % 2 == 0 ? unit(random) : std::sqrt(unit(random)));
+    const Vec2 centre{{rho * std::cos(phi), rho * std::sin(phi)}};
+    WallContact<2> found[8];
+    const int n = mill_contacts(mill, centre, r, found);
+    for (int k = 0; k < mill.lifter_count; ++k) {
+      if (distance_to_lifter(mill, k, centre) >= r) continue;
+      ++touching;
+      const bool listed = std::any_of(found, found + n, [&](const WallContact<2>& contact) {
+        return contact.wall_id == 1 + k;
+      });
+      missed += listed ? 0 : 1;
+    }
+  }
+  return {missed, touching};
+}
+
+TEST(MillWall, EveryLifterADiscTouchesIsFoundUpToTheWidestParticleForTheLifters) {
   // The contact search tests the lifter nearest a disc and its two neighbours; plan_mill refuses
-  // mills whose lifters two apart stand closer than the largest ball. At that limit (the disc's
-  // diameter the distance), discs anywhere in the mill, most of them against the lifters: every
-  // lifter a disc overlaps is among its contacts. Mills of few tall lifters (near the axis they
-  // converge) and of many small ones.
+  // a mill whose largest ball is wider than widest_particle_for_lifters. Discs of that width
+  // overlap no lifter beyond the three, in mills of few tall lifters (near the axis they
+  // converge: the limit is then 2 (R − h)) and of many small ones; discs 2 % wider do, so the
+  // limit is the search's, not merely a safe one. (In each mill the centre closest to the
+  // lifter left out, on the ray 3π/n off its middle, is one a disc of that size can reach
+  // inside the shell; where it is not, the limit is safe but not tight.)
   struct Case {
     int count;
-    double height, width;
+    double height, width, widest;
   };
   std::mt19937_64 random(7);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  for (const Case c : {Case{4, 0.3, 0.05}, Case{5, 0.25, 0.1}, Case{8, 0.04, 0.04},
-                       Case{60, 0.1, 0.02}, Case{200, 0.02, 0.01}}) {
+  for (const Case c : {Case{4, 0.3, 0.05, 0.4}, Case{6, 0.3, 0.1, 0.39999998999999},
+                       Case{30, 0.15, 0.04, 0.1782696}, Case{60, 0.1, 0.02, 0.1053937},
+                       Case{200, 0.02, 0.01, 0.0352332}}) {
     Mill2D mill;
     mill.radius = 0.5;
     mill.lifter_count = c.count;
     mill.lifter_height = c.height;
     mill.lifter_width = c.width;
     mill.turn_to(0.3);
-    const double diameter =
-        distance_between_lifters_two_apart(mill.radius, c.count, c.height, c.width);
-    ASSERT_GT(diameter, 0.0);
-    const double r = 0.5 * diameter;
-    long touching = 0;
-    for (int trial = 0; trial < 100000; ++trial) {
-      // Half the discs within a radius of the lifters' inner faces, the rest anywhere inside.
-      const double phi = 2.0 * pi * unit(random);
-      const double inner = mill.radius - c.height;
-      const double rho = trial % 2 == 0 ? std::max(0.0, inner - r + 2.0 * r * unit(random))
-                                        : (mill.radius - r) * std::sqrt(unit(random));
-      const Vec2 centre{{rho * std::cos(phi), rho * std::sin(phi)}};
-      WallContact<2> found[8];
-      const int n = mill_contacts(mill, centre, r, found);
-      for (int k = 0; k < c.count; ++k) {
-        if (distance_to_lifter(mill, k, centre) >= r) continue;
-        ++touching;
-        const bool listed = std::any_of(found, found + n, [&](const WallContact<2>& contact) {
-          return contact.wall_id == 1 + k;
-        });
-        ASSERT_TRUE(listed) << c.count << " lifters: the disc of radius " << r << " at ("
-                            << centre[0] << ", " << centre[1] << ") touches lifter " << k
-                            << ", not among its " << n << " contacts";
-      }
-    }
+    const double widest = widest_particle_for_lifters(mill.radius, c.count, c.height, c.width);
+    EXPECT_NEAR(widest, c.widest, 1e-6) << c.count << " lifters";
+    const auto [missed, touching] = lifter_contacts_missed(mill, widest, random);
+    EXPECT_EQ(missed, 0) << c.count << " lifters: discs of the widest size, " << widest << " m";
     EXPECT_GT(touching, 10000) << c.count << " lifters: too few discs touched one";
+    const auto [missed_wider, touching_wider] = lifter_contacts_missed(mill, 1.02 * widest, random);
+    EXPECT_GT(missed_wider, 0) << c.count << " lifters: discs 2 % wider, " << touching_wider
+                               << " lifter overlaps";
   }
 }
 

@@ -306,20 +306,22 @@ TEST_F(Cli, RefusesASlabTooShortForItsBalls) {
 }
 
 TEST_F(Cli, RefusesLiftersSoCloseThatABallCouldTouchOneBeyondTheNeighbours) {
-  // The contact search tests the nearest lifter and its two neighbours: lifters two apart must
-  // stand a largest ball diameter apart. 70 lifters 0.1 m high and 0.02 m wide in the 0.9 m
-  // mill: their facing inner corners, at 0.3506 m from the axis and 0.02856 rad off each
-  // lifter's middle, are 2 (0.3506) sin(4π/140 − 0.02856) = 0.04283 m apart, less than 0.0508 m.
+  // The contact search tests the nearest lifter and its two neighbours. 70 lifters 0.1 m high
+  // and 0.02 m wide in the 0.9 m mill: their inner corners are 0.3501 m from the axis, 0.02856
+  // rad off each lifter's middle, and a ball may be at most 2 (0.3501) sin(3π/70 − 0.02856) =
+  // 0.07414 m wide (widest_particle_for_lifters). Balls of 8 cm: refused.
   const std::string dense =
-      with(with(with(base_config, "count", "count = 70"), "height", "height = 0.1"), "width",
-           "width = 0.02");
+      with(with(with(with(base_config, "count", "count = 70"), "height", "height = 0.1"), "width",
+                "width = 0.02"),
+           "ball_diameter", "ball_diameter = 0.08");
   expect_refused(run_config(dense),
-                 {at_line(dense, "count"), "mill.lifters.count", "0.04283 m apart",
-                  "less than the largest ball, 0.0508 m",
+                 {at_line(dense, "count"), "mill.lifters.count",
+                  "a ball wider than 0.07414 m can touch a lifter beyond the two neighbours",
+                  "the largest ball is 0.08 m",
                   "allowed: fewer, lower or narrower lifters, or smaller balls"});
-  // 60 of them stand 0.0533 m apart: accepted.
-  const std::string fewer = with(dense, "count = 70", "count = 60");
-  const Outcome accepted = run_config(fewer, tiny_run);
+  // Balls of 7 cm: accepted.
+  const std::string smaller = with(dense, "ball_diameter", "ball_diameter = 0.07");
+  const Outcome accepted = run_config(smaller, tiny_run);
   EXPECT_EQ(accepted.status, 0) << accepted.err;
 }
 
@@ -933,33 +935,40 @@ TEST_F(Cli, AValidationStoppedHalfWayLeavesNothingOfTheOneBefore) {
                      "snapshot_interval", "snapshot_interval = 0"),
                 "time_step", "time_step = \"auto\"");
   };
-  for (const char* name : {"a", "b", "c"}) write_case(name, "1");
-  const Outcome first = millsim("validate cases -q -j 1 -o runs");
-  ASSERT_NE(first.status, 2) << first.err;
-  for (const char* name : {"a", "b", "c"}) {
-    ASSERT_TRUE(fs::exists(work_ / "runs" / name / "summary.json")) << name;
+  // Into runs/, and into a link to a directory (real/, through linked), whose case c is a link
+  // too (to elsewhere/).
+  fs::create_directories(work_ / "real");
+  fs::create_directories(work_ / "elsewhere");
+  fs::create_directory_symlink("real", work_ / "linked");
+  fs::create_directory_symlink("../elsewhere", work_ / "real" / "c");
+  for (const std::string out : {"runs", "linked"}) {
+    for (const char* name : {"a", "b", "c"}) write_case(name, "1");
+    const Outcome first = millsim("validate cases -q -j 1 -o " + out);
+    ASSERT_NE(first.status, 2) << first.err;
+    for (const char* name : {"a", "b", "c"}) {
+      ASSERT_TRUE(fs::exists(work_ / out / name / "summary.json")) << out << "/" << name;
+    }
+    ASSERT_TRUE(fs::exists(work_ / out / "validation.csv")) << out;
+    write_case("b", "100000");
+    // Stopped once a's new summary is written and b's earlier one gone, that is once b runs
+    // (at most two minutes on), whatever the build's speed.
+    const std::string stopped = fmt::format(
+        "cd {} && {{ {} validate cases -q -j 1 -o {} >/dev/null 2>&1 & pid=$!; n=0; "
+        "while {{ [ ! -f {}/a/summary.json ] || [ -f {}/b/summary.json ]; }} && [ $n -lt 2400 ] "
+        "&& kill -0 $pid 2>/dev/null; do sleep 0.05; n=$((n+1)); done; kill -TERM $pid; "
+        "wait $pid; }}",
+        work_.string(), MILLSIM_BINARY, out, out, out);
+    const int raw = std::system(stopped.c_str());
+    ASSERT_TRUE(WIFEXITED(raw)) << out << ": " << raw;
+    ASSERT_EQ(WEXITSTATUS(raw), 128 + SIGTERM) << out << ": stopped by the signal";
+    EXPECT_TRUE(fs::exists(work_ / out / "a" / "summary.json")) << out << ": a ran again";
+    EXPECT_FALSE(fs::exists(work_ / out / "b" / "summary.json")) << out << ": b was stopped";
+    EXPECT_FALSE(fs::exists(work_ / out / "validation.csv")) << out;
+    for (const auto& entry : fs::directory_iterator(work_ / out / "c")) {
+      ADD_FAILURE() << out << ": left in c: " << entry.path();
+    }
   }
-  ASSERT_TRUE(fs::exists(work_ / "runs" / "validation.csv"));
-  write_case("b", "100000");
-  // Stopped once a's new summary is written and b's earlier one gone, that is once b runs (at
-  // most two minutes on), whatever the build's speed.
-  const std::string stopped =
-      "cd " + work_.string() + " && { " + std::string(MILLSIM_BINARY) +
-      " validate cases -q -j 1 -o runs >/dev/null 2>&1 & pid=$!; n=0; "
-      "while { [ ! -f runs/a/summary.json ] || [ -f runs/b/summary.json ]; } && [ $n -lt 2400 ] "
-      "&& kill -0 $pid 2>/dev/null; do "
-      "sleep 0.05; n=$((n+1)); done; kill -TERM $pid; wait $pid; }";
-  const int raw = std::system(stopped.c_str());
-  ASSERT_TRUE(WIFEXITED(raw)) << raw;
-  ASSERT_EQ(WEXITSTATUS(raw), 128 + SIGTERM) << "stopped by the signal";
-  EXPECT_TRUE(fs::exists(work_ / "runs" / "a" / "summary.json")) << "a ran again";
-  EXPECT_FALSE(fs::exists(work_ / "runs" / "b" / "summary.json")) << "b was stopped";
-  EXPECT_FALSE(fs::exists(work_ / "runs" / "c" / "summary.json")) << "c's are the earlier ones";
-  EXPECT_FALSE(fs::exists(work_ / "runs" / "c" / "power.csv"));
-  EXPECT_FALSE(fs::exists(work_ / "runs" / "validation.csv"));
-  for (const auto& entry : fs::directory_iterator(work_ / "runs" / "c")) {
-    ADD_FAILURE() << "left in c: " << entry.path();
-  }
+  EXPECT_TRUE(fs::is_symlink(work_ / "real" / "c")) << "the link is kept";
 }
 
 TEST_F(Cli, ValidateReadsEveryCaseBeforeRunningAnyAndShowsAMissingPaperFigureAsNa) {

@@ -42,8 +42,8 @@ bool lifter_contact(const Mill2D& mill, int index, const Vec2& planar_centre, do
     contact.overlap = particle_radius - distance;
     if (axial_normal != nullptr) *axial_normal = axial / distance;
   } else if (axial > 0.0) {
-    // Beyond the bar's end, level with its end face: the normal is along the axis (whatever the
-    // rounding of a distance next to nothing, whose square may be 0).
+    // Beyond the bar's end, level with its end face: the normal is along the axis, exactly (the
+    // distance may be next to nothing, and the overlap r − distance then rounds to r).
     contact.overlap = particle_radius - distance;
     if (axial_normal != nullptr) *axial_normal = 1.0;
   } else {
@@ -91,8 +91,8 @@ double approximate_atan2(double y, double x) {
 }
 
 /// The lifters a particle at `planar_centre` may touch: the one nearest to it by angle and
-/// that lifter's two neighbours (any lifter further round lies behind one of those, for
-/// particles no wider than distance_between_lifters_two_apart, which plan_mill checks). Calls
+/// that lifter's two neighbours (any lifter further round is out of reach of particles no
+/// wider than widest_particle_for_lifters, which plan_mill checks). Calls
 /// visit(index) for each. The nearest one is found from an approximate angle: it can differ
 /// from the exact one's only for a centre within 2e-8 rad of half-way between two lifters,
 /// which then touches neither of the two lifters beyond them that the choice decides between.
@@ -245,17 +245,17 @@ void Mill2D::turn_to(double new_angle) {
   }
 }
 
-double distance_between_lifters_two_apart(double radius, int count, double height, double width) {
-  // The inner corner of lifter k towards lifter k + 2, (R − h, w/2) in k's frame, is at
-  // distance ρ = hypot(R − h, w/2) from the axis and angle β = atan(w/2 / (R − h)) off k's
-  // middle; k + 2's facing corner is its mirror image about the line half-way between them,
-  // 4π/n round. The two chords between them span 4π/n − 2β. Other points of the bars are
-  // further apart: the sides and inner faces turn away from each other (4π/n ≤ π).
+double widest_particle_for_lifters(double radius, int count, double height, double width) {
   const double inner = radius - height;
   const double half_width = 0.5 * width;
   const double corner_radius = std::hypot(inner, half_width);
   const double corner_angle = std::atan2(half_width, inner);
-  return 2.0 * corner_radius * std::sin(2.0 * pi / count - corner_angle);
+  // The nearest lifter is found from an approximate angle, within 2e-8 rad of the exact one
+  // (for_each_nearby_lifter): the ray is taken that much nearer.
+  constexpr double angle_error = 1e-7;
+  const double off_corner = 3.0 * pi / count - angle_error - corner_angle;
+  const double half = off_corner <= 0.5 * pi ? corner_radius * std::sin(off_corner) : inner;
+  return 2.0 * half;
 }
 
 NearbyLifters nearby_lifters(const Mill2D& mill, const Vec2& planar_centre, double reach) {

@@ -92,15 +92,16 @@ struct NearbyLifters {
 /// is among those within r + d + s. In mill_geometry.cpp.
 NearbyLifters nearby_lifters(const Mill2D& mill, const Vec2& planar_centre, double reach);
 
-/// The distance between two lifters with one between them (lifters k and k + 2 of `count`
-/// ≥ 4 lifters of the given height and width in a shell of `radius`): the distance between
-/// their facing inner corners, which are the closest points of the two bars. The contact search
-/// tests the lifter nearest a particle and its two neighbours (mill_contacts); it finds every
-/// lifter a particle touches as long as the particle's diameter is at most this distance, which
-/// plan_mill checks for the largest ball (a particle's distance to a lifter grows with the angle
-/// between them, so one touching a lifter beyond those three would touch the nearest one as
-/// well, and so two lifters this far apart). In mill_geometry.cpp.
-double distance_between_lifters_two_apart(double radius, int count, double height, double width);
+/// The widest particle whose lifter contacts are all among those the contact search tests (the
+/// lifter nearest the particle by angle and its two neighbours: mill_contacts), for `count` ≥ 4
+/// lifters of the given height and width in a shell of `radius`. A particle nearest lifter k
+/// has its centre within π/n of k's middle, so at least 3π/n from lifter k + 2's (and k − 2's);
+/// the distance from such a centre to that lifter is least on the ray 3π/n off its middle
+/// (it grows with the angle), where it is ρ sin(3π/n − β) to the lifter's inner corner,
+/// ρ = hypot(R − h, w/2) from the axis at β = atan(w/2 / (R − h)) off its middle, or, once the
+/// ray turns away from that corner (3π/n − β > π/2), R − h, from the axis. Twice that is the
+/// widest particle. plan_mill refuses a mill whose largest ball is wider. In mill_geometry.cpp.
+double widest_particle_for_lifters(double radius, int count, double height, double width);
 
 /// An infinite plane (a line in 2D): the particle side is where (x − point)·normal > 0.
 template <int D>

@@ -153,21 +153,18 @@ MillPlan plan_mill(const MillConfig& config) {
   plan.revolution_period = 60.0 / plan.speed_rpm;
 
   if (config.lifter_count >= 4) {
-    // Every lifter a ball touches is among the three the contact search tests (the nearest by
-    // angle and its two neighbours) while no ball can reach across a lifter to the next but one
-    // (distance_between_lifters_two_apart).
-    const double apart = distance_between_lifters_two_apart(
-        plan.radius, config.lifter_count, config.lifter_height, config.lifter_width);
-    if (apart < plan.largest_ball) {
+    // Every lifter a ball touches must be among the three the contact search tests (the
+    // nearest by angle and its two neighbours): widest_particle_for_lifters.
+    const double widest = widest_particle_for_lifters(plan.radius, config.lifter_count,
+                                                      config.lifter_height, config.lifter_width);
+    if (plan.largest_ball > widest) {
       throw InputError(fmt::format(
-          "{}: mill.lifters.count: {} lifters {} m high and {} m wide stand {:.4g} m apart "
-          "from each lifter to the next but one (corner to corner), less than the largest "
-          "ball, {} m: a ball could touch more lifters at once than millsim tests (the "
-          "nearest and its two neighbours); allowed: fewer, lower or narrower lifters, or "
-          "smaller balls, so that lifters two apart stand at least a largest ball diameter "
-          "apart",
+          "{}: mill.lifters.count: with {} lifters {} m high and {} m wide a ball wider than "
+          "{:.4g} m can touch a lifter beyond the two neighbours of its nearest one, which "
+          "millsim does not test, and the largest ball is {} m; allowed: fewer, lower or "
+          "narrower lifters, or smaller balls, so that the largest ball is at most that wide",
           config.location_of("mill.lifters.count"), config.lifter_count, config.lifter_height,
-          config.lifter_width, apart, plan.largest_ball));
+          config.lifter_width, widest, plan.largest_ball));
     }
   }
   if (config.periodic && config.slab_length < 3.0 * plan.largest_ball) {

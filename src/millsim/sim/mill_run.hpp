@@ -65,8 +65,8 @@ struct MillResult {
   /// (World::largest_overlap_fraction), the most at the end of settling and at each of the 50
   /// samples a revolution while the shell turns.
   double largest_overlap_fraction = 0.0;
-  /// World::dropped_wall_contacts at the end (none is possible in a mill plan_mill accepts;
-  /// result_warnings would say so).
+  /// World::dropped_wall_contacts at the end (none is expected in a mill; result_warnings
+  /// would say so).
   long dropped_wall_contacts = 0;
   /// The liner layer's balls by angle over the measured window, and from them the charge's toe
   /// and shoulder (ChargeProfile; sampled 50 times a revolution, with the charge's centre).

@@ -227,8 +227,9 @@ class World {
   /// Wall contacts left out since the world was made because every one of the particle's
   /// max_wall_contacts slots of wall-contact history held another wall: a particle pressed
   /// into more walls at once than that (five or more of a scene's planes in 2D, say). A mill's
-  /// particles cannot touch so many (its lifters are refused closer than a ball can reach
-  /// across: plan_mill). The runs warn of any.
+  /// particle touches at most the shell, three lifters (the search tests no more) and, in 3D,
+  /// an end plate or a cone and its trunnion plate: as many as the slots in 2D, one fewer in
+  /// 3D. The runs warn of any.
   long dropped_wall_contacts() const { return dropped_wall_contacts_; }
   /// Particles that may touch a wall before the next neighbour-list rebuild.
   std::size_t wall_candidate_count() const { return wall_candidates_.size(); }
@@ -688,7 +689,7 @@ class World {
   double lifter_travel_ = 0.0;
   int nearby_lifter_count_ = 0;
   long nearby_lifter_refreshes_ = 0;
-  long dropped_wall_contacts_ = 0;  // (added to by the threads' wall stages, atomically)
+  long dropped_wall_contacts_ = 0;          // (added to by the threads' wall stages, atomically)
   std::vector<EndedCollision> wall_ended_;  // block b's at [b × wall_block_ × max, ...)
   std::vector<std::uint32_t> wall_block_ended_;
   std::vector<double> wall_block_dissipated_, wall_block_torque_, wall_block_work_;
