@@ -17,9 +17,12 @@
 #include "millsim/measure/spectrum.hpp"
 #include "millsim/sim/charge.hpp"
 #include "millsim/sim/world.hpp"
+#include "support/lifter_distance.hpp"
 
 namespace millsim {
 namespace {
+
+using testing::distance_to_lifter;
 
 // The lab mill's shell and balls: R = 0.45 m, a 5.08 cm steel ball, m = ρ π d³/6
 // = 7800 × 0.52359878 × 1.31096512e-4 = 0.53540739 kg, weight m g = 5.2523465 N; the paper's steel
@@ -285,21 +288,6 @@ TEST(MillWall, DiscJustClearOfALifterHasNoContact) {
       mill_contacts(mill, corner + (ball_radius + 1e-6) * f.at(-0.6, 0.8), ball_radius, found), 0);
 }
 
-// ---- Determinism ---------------------------------------------------------------------------
-
-/// Distance from `centre` to lifter k's bar, worked out directly: the bar spans R − h to
-/// R + h along its middle (it reaches past the shell) and ±w/2 across.
-double distance_to_lifter(const Mill2D& mill, int k, const Vec2& centre) {
-  const double angle = mill.angle + 2.0 * pi * k / mill.lifter_count;
-  const double along = centre[0] * std::cos(angle) + centre[1] * std::sin(angle);
-  const double across = -centre[0] * std::sin(angle) + centre[1] * std::cos(angle);
-  const double outside_along =
-      along - std::clamp(along, mill.radius - mill.lifter_height, mill.radius + mill.lifter_height);
-  const double outside_across =
-      across - std::clamp(across, -0.5 * mill.lifter_width, 0.5 * mill.lifter_width);
-  return std::hypot(outside_along, outside_across);
-}
-
 /// Discs of `diameter` in `mill`, half of them centred half-way between two lifters (where the
 /// farthest lifters the search leaves out are nearest), the rest anywhere inside: how many
 /// overlap a lifter that is not among their contacts, and how many lifter overlaps there were.
@@ -363,6 +351,8 @@ TEST(MillWall, EveryLifterADiscTouchesIsFoundUpToTheWidestParticleForTheLifters)
                                << " lifter overlaps";
   }
 }
+
+// ---- Determinism ---------------------------------------------------------------------------
 
 TEST(MillWall, TheExampleMillRunsBitForBitTheSameTwice) {
   // The built-in example (75 discs, eight lifters), short: 1500 steps with the shell still (the

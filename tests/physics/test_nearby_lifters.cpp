@@ -18,22 +18,13 @@
 #include "millsim/io/config.hpp"
 #include "millsim/sim/charge.hpp"
 #include "millsim/sim/world.hpp"
+#include "support/lifter_distance.hpp"
 #include "support/turning_world.hpp"
 
 namespace millsim {
 namespace {
 
-/// Distance from `centre` to lifter `k`'s bar (radial span R − h … R + h, width w), worked
-/// out here independently of the library: the centre in the lifter's frame, clamped to the bar.
-double distance_to_lifter(const Mill2D& mill, int k, const Vec2& centre) {
-  const double angle = mill.angle + 2.0 * pi * k / mill.lifter_count;
-  const double a = centre[0] * std::cos(angle) + centre[1] * std::sin(angle);
-  const double b = -centre[0] * std::sin(angle) + centre[1] * std::cos(angle);
-  const double da =
-      a - std::clamp(a, mill.radius - mill.lifter_height, mill.radius + mill.lifter_height);
-  const double db = b - std::clamp(b, -0.5 * mill.lifter_width, 0.5 * mill.lifter_width);
-  return std::sqrt(da * da + db * db);
-}
+using testing::distance_to_lifter;
 
 Mill2D mill_with(int lifters, double height, double width, double angle) {
   Mill2D mill;
