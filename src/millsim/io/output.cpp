@@ -443,8 +443,10 @@ std::vector<std::string> result_warnings(const MillResult& r) {
         percent, 100.0 * doubtful_energy_balance_error));
   }
   // A balance that does not close explains any disagreement of the two powers.
-  const double larger = std::max(std::abs(r.power_kw), std::abs(r.power_dissipation_kw));
-  if (warnings.empty() && larger > 0.0 &&
+  // (Two powers that are next to none are not compared: their gap is rounding.)
+  const double larger = std::max(
+      {std::abs(r.power_kw), std::abs(r.power_dissipation_kw), least_drive_power(r.plan) / 1000.0});
+  if (warnings.empty() &&
       std::abs(r.power_kw - r.power_dissipation_kw) > doubtful_power_disagreement * larger) {
     const MillConfig& c = r.plan.config;
     const bool spin_up_measured = c.measure_revolutions >= c.revolutions;

@@ -61,6 +61,11 @@ double spin_up_time(const MillPlan& plan) {
   return plan.spin_up_time;
 }
 
+double least_drive_power(const MillPlan& plan) {
+  return 1e-3 * plan.power_scale * plan.slice_mass * standard_gravity * plan.radius *
+         plan.angular_speed;
+}
+
 template <int D>
 MillResult run_mill(const MillPlan& plan, World<D> world,
                     const std::filesystem::path& snapshot_directory,
@@ -179,7 +184,11 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
   result.torque_nm = plan.power_scale * window_torque_time / window;
   const double change =
       (b.kinetic - a.kinetic) + (b.potential - a.potential) + (b.stored - a.stored);
-  result.energy_balance_error = std::abs(work - (change + dissipated)) / std::abs(work);
+  // Relative to the shell's work, or, where the drive does next to no work, to the least
+  // drive power's over the window (least_drive_power): against rounding a ratio says nothing.
+  result.energy_balance_error =
+      std::abs(work - (change + dissipated)) /
+      std::max(std::abs(work), least_drive_power(plan) / plan.power_scale * window);
   const auto measured = static_cast<std::size_t>(plan.config.measure_revolutions);
   const std::size_t first =
       result.revolutions.size() - std::min(measured, result.revolutions.size());

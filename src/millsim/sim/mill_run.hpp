@@ -94,6 +94,14 @@ extern template MillResult run_mill<3>(const MillPlan&, World<3>, const std::fil
 /// period.
 double spin_up_time(const MillPlan& plan);
 
+/// W, whole mill: a thousandth of M g R ω, M the mill's charge — of the power of a drive holding
+/// the whole charge out at the shell, of which a tumbling charge draws a fifth to a third. A
+/// drive's power below it is next to none (a smooth, frictionless shell draws only its sums'
+/// rounding), and the run's relative checks take it as their least scale: the energy balance
+/// is relative to the shell's work or to this over the window, whichever is larger, and two
+/// powers below it are not compared.
+double least_drive_power(const MillPlan& plan);
+
 /// The centre of mass of the particles in the cross-section (x, y), and their angular speed
 /// about the mill axis as a rigid body would have it: their angular momentum about the axis
 /// over their moment of inertia about it, Σ m (x × v) / Σ m |x|² (in the cross-section; the
