@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "millsim/core/constants.hpp"
@@ -392,9 +393,9 @@ TEST(LeapfrogStability, BoundedJustBelowTheLimitAndGrowingJustAboveIt) {
 // normal one, so the library's limit is the tangential 2/ω. Started with the slip speed ε (the
 // disc sliding, not turning), the slip speed v_x + ω r stays within the leapfrog's invariant
 // bound below the limit and grows by |λ| a step above it.
-double largest_slip_speed_on_floor(double limit_fraction, int steps) {
+double largest_slip_speed_on_floor(double limit_fraction, int steps,
+                                   const ContactMaterial& material = {1.0e6, 1.0e6, 1.0, 10.0}) {
   const double radius = 0.05, mass = 2.0, nudge = 1e-6;
-  const ContactMaterial material{1.0e6, 1.0e6, 1.0, 10.0};
   WorldSettings<2> settings;
   settings.time_step =
       limit_fraction * critical_time_step(material, mass, tangential_mass(mass, 0.0, 0.5));
@@ -428,6 +429,76 @@ TEST(LeapfrogStability, TheTangentialLimitBindsWhereItIsTheShorter) {
   EXPECT_LT(below, 1.001 / std::sqrt(1.0 - half_angle * half_angle));
   EXPECT_GT(below, 4.0);  // the bound, 5.025, is reached (seen: 5.02519)
   EXPECT_GT(largest_slip_speed_on_floor(1.02, 200), 1e3);
+}
+
+// With damping the limit is lower: each mode is a damped oscillator whose dashpot sees the
+// velocity estimated at the time of the positions, u̇(n−½) + ½ ü(n−1) Δt, and its leapfrog is
+// stable for ω Δt < 2 / (sqrt(1 + 4 ζ²) + 2 ζ) (docs/model.md, "Time step"). Below it the
+// motion dies away; just above it the mode grows by nearly 1 + (its distance from the limit) a
+// step. At e = 0.6 the undamped limit 2/ω was 1.37 times too long for the normal mode and 1.70
+// for a disc's tangential one, and a lab mill run at 0.9 of it was off in its energy balance
+// by 1056 % (a review's finding, 2026-12-07).
+
+// The normal mode: a disc resting on the floor under gravity, e = 0.6, its tangential spring
+// soft enough (k_s = k_n / 10) that the normal mode sets the limit, started with the vertical
+// speed ε. Returns the largest vertical speed over ε in `steps` steps, and in the last tenth.
+std::pair<double, double> largest_bounce_speed_on_floor(double limit_fraction, int steps) {
+  const double radius = 0.05, mass = 2.0, nudge = 1e-6;
+  const ContactMaterial material{1.0e6, 1.0e5, 0.6, 10.0};
+  WorldSettings<2> settings;
+  settings.time_step =
+      limit_fraction * critical_time_step(material, mass, tangential_mass(mass, 0.0, 0.5));
+  settings.gravity = Vec2{{0.0, -standard_gravity}};
+  settings.ball_wall = material;
+  Walls<2> walls;
+  walls.planes.push_back(Plane<2>{Vec2{{0.0, 0.0}}, Vec2{{0.0, 1.0}}});
+  World<2> world(settings, walls);
+  const double rest = radius - mass * standard_gravity / material.normal_stiffness;
+  world.particles().add(Vec2{{0.0, rest}}, radius, mass, Vec2{{0.0, nudge}});
+  double largest = 0.0;
+  double last = 0.0;
+  for (int n = 0; n < steps; ++n) {
+    world.step();
+    const double speed = std::abs(world.particles().velocity[0][1]);
+    largest = std::max(largest, speed);
+    if (n >= steps - steps / 10) last = std::max(last, speed);
+    if (largest > 1e4 * nudge) break;  // the disc would soon leave the floor
+  }
+  return {largest / nudge, last / nudge};
+}
+
+TEST(LeapfrogStability, DampingLowersTheNormalLimitAndTheLibrarySaysByHowMuch) {
+  // ζ = 0.16049305 for e = 0.6: ω Δt < 2 / (sqrt(1 + 4 ζ²) + 2 ζ) = 2 / 1.3712394.
+  const double mass = 2.0;
+  const ContactMaterial material{1.0e6, 1.0e5, 0.6, 10.0};
+  EXPECT_NEAR(critical_time_step(material, mass, tangential_mass(mass, 0.0, 0.5)),
+              2.0 / (std::sqrt(material.normal_stiffness / mass) * 1.3712394), 1e-9);
+  const auto [below, below_late] = largest_bounce_speed_on_floor(0.98, 20000);
+  const auto [above, above_late] = largest_bounce_speed_on_floor(1.02, 20000);
+  record("bounce_speed_below", below);
+  record("bounce_speed_below_late", below_late);
+  record("bounce_speed_above", above);
+  EXPECT_LT(below, 1.5);        // never much above the nudge
+  EXPECT_LT(below_late, 1e-2);  // and dying away
+  EXPECT_GT(above, 1e3);        // at 1.02 of the limit, growing
+  // The undamped limit of before, 1.37 times longer, is far into the growth.
+  EXPECT_GT(largest_bounce_speed_on_floor(1.3, 200).first, 1e3);
+}
+
+TEST(LeapfrogStability, DampingLowersTheTangentialLimitAndTheLibrarySaysByHowMuch) {
+  // The sticking disc above with e = 0.6: its tangential ratio is ζ sqrt(m*/m_t) = ζ √3 =
+  // 0.27798211, ω Δt < 2 / (sqrt(1 + 4 · 3 ζ²) + 2 √3 ζ) = 2 / 1.7001216.
+  const double mass = 2.0;
+  const ContactMaterial material{1.0e6, 1.0e6, 0.6, 10.0};
+  EXPECT_NEAR(critical_time_step(material, mass, tangential_mass(mass, 0.0, 0.5)),
+              2.0 / (std::sqrt(3.0 * material.tangential_stiffness / mass) * 1.7001216), 1e-9);
+  const double below = largest_slip_speed_on_floor(0.98, 20000, material);
+  const double above = largest_slip_speed_on_floor(1.02, 20000, material);
+  record("damped_slip_speed_below", below);
+  record("damped_slip_speed_above", above);
+  EXPECT_LT(below, 1.5);
+  EXPECT_GT(above, 1e3);
+  EXPECT_GT(largest_slip_speed_on_floor(1.6, 200, material), 1e3);
 }
 
 /// A disc of `mass` at rest at `at` above a floor at y = 0, under gravity, the contact with

@@ -86,16 +86,26 @@ TEST(Material, ContactDurationByHand) {
 }
 
 TEST(Material, CriticalTimeStepByHand) {
-  // Two 1 kg discs: m* = 0.5 kg, m_t = 1/6 kg (see TangentialMassByHand). Normal frequency
-  // sqrt(4e5 / 0.5) = 894.42719 s⁻¹; tangential sqrt(3e5 · 6) = 1341.6408 s⁻¹, the larger, so
-  // Δt_crit = 2 / 1341.6408 = 1.4907120e-3 s.
+  // Two 1 kg discs: m* = 0.5 kg, m_t = 1/6 kg (see TangentialMassByHand). Undamped (e = 1): the
+  // normal frequency sqrt(4e5 / 0.5) = 894.42719 s⁻¹, the tangential sqrt(3e5 · 6) =
+  // 1341.6408 s⁻¹, the larger, so Δt_crit = 2 / 1341.6408 = 1.4907120e-3 s.
   const double disc_pair_tangential_mass = 1.0 / 6.0;
-  EXPECT_NEAR(critical_time_step(steel(), pair_mass, disc_pair_tangential_mass), 1.4907120e-3,
+  EXPECT_NEAR(critical_time_step(steel(1.0), pair_mass, disc_pair_tangential_mass), 1.4907120e-3,
               1.4907120e-3 * hand_tolerance);
-  // With a soft tangential spring (k_s = 1e4: sqrt(1e4 · 6) = 244.94897 s⁻¹) the normal one
-  // sets the step: 2 / 894.42719 = 2.2360680e-3 s = 2 sqrt(m*/k_n).
+  // e = 0.6: ζ = −ln 0.6 / sqrt(ln² 0.6 + π²) = 0.51082562 / 3.1828521 = 0.16049305, and the
+  // tangential mode's ζ sqrt(m*/m_t) = ζ √3 = 0.27798211. Each mode's limit is
+  // 2 / (ω (sqrt(1 + 4 ζ²) + 2 ζ)): normal 2 / (894.42719 · 1.3712394) = 1.6306911e-3 s,
+  // tangential 2 / (1341.6408 · 1.7001216) = 8.7682666e-4 s, the shorter.
+  EXPECT_NEAR(critical_time_step(steel(), pair_mass, disc_pair_tangential_mass), 8.7682666e-4,
+              8.7682666e-4 * hand_tolerance);
+  // With a soft tangential spring (k_s = 1e4: 2 / (sqrt(1e4 · 6) · 1.7001216) = 4.8025774e-3 s)
+  // the normal mode sets the step: 1.6306911e-3 s, below the undamped 2 sqrt(m*/k_n) =
+  // 2.2360680e-3 s.
   ContactMaterial soft_tangential = steel();
   soft_tangential.tangential_stiffness = 1.0e4;
+  EXPECT_NEAR(critical_time_step(soft_tangential, pair_mass, disc_pair_tangential_mass),
+              1.6306911e-3, 1.6306911e-3 * hand_tolerance);
+  soft_tangential.restitution = 1.0;
   EXPECT_NEAR(critical_time_step(soft_tangential, pair_mass, disc_pair_tangential_mass),
               2.2360680e-3, 2.2360680e-3 * hand_tolerance);
 }

@@ -184,14 +184,16 @@ TEST(MillPlan, AutoTimeStepIsATwentiethOfTheShortestContact) {
 }
 
 TEST(MillPlan, GivenTimeStepIsUsedBelowTheStabilityLimitAndRefusedAboveIt) {
-  // Stability limit 2/ω_max. Two 5.08 cm discs: normal ω = sqrt(k_n/m*) = sqrt(4e5/0.26770370)
-  // = 1222.3704 s⁻¹; tangential, with 1/m_t = 2 (1 + 1/(1/2))/m = 6/m: sqrt(6 k_s/m)
-  // = sqrt(1.8e6/0.53540739) = 1833.5555 s⁻¹ (a wall, m_t = m/3, is slower). Limit
-  // 2/1833.5555 = 1.0907769e-3 s.
+  // Stability limit: each mode's 2 / (ω (sqrt(1 + 4 ζ²) + 2 ζ)), the shorter (docs/model.md).
+  // Two 5.08 cm discs: normal ω = sqrt(k_n/m*) = sqrt(4e5/0.26770370) = 1222.3704 s⁻¹ with
+  // e = 0.6's ζ = 0.16049305, sqrt(1 + 4 ζ²) + 2 ζ = 1.3712394: 1.1932017e-3 s; tangential,
+  // with 1/m_t = 2 (1 + 1/(1/2))/m = 6/m: ω = sqrt(6 k_s/m) = sqrt(1.8e6/0.53540739) =
+  // 1833.5555 s⁻¹ with ζ sqrt(m*/m_t) = ζ √3, sqrt(1 + 4 ζ²·3) + 2 ζ √3 = 1.7001216:
+  // 6.4158756e-4 s, the shorter (a wall's, m* = m and m_t = m/3, are longer).
   const MillPlan plan = plan_mill(lab_mill());
-  EXPECT_HAND(plan.critical_time_step, 1.0907769e-3);
-  EXPECT_EQ(plan_mill(lab_mill({"simulation.time_step=1e-3"})).time_step, 1e-3);
-  EXPECT_THROW(plan_mill(lab_mill({"simulation.time_step=1.1e-3"})), InputError);
+  EXPECT_HAND(plan.critical_time_step, 6.4158756e-4);
+  EXPECT_EQ(plan_mill(lab_mill({"simulation.time_step=6.4e-4"})).time_step, 6.4e-4);
+  EXPECT_THROW(plan_mill(lab_mill({"simulation.time_step=6.5e-4"})), InputError);
 }
 
 TEST(MillPlan, AGivenTimeStepOfFewerThanTenStepsPerContactIsRunWithAWarning) {
@@ -249,12 +251,12 @@ TEST(MillPlan, SnapshotsAreCountedAndTheirSizeBoundedWithAWarningWhenLarge) {
 
 TEST(MillPlan, AutoTimeStepStaysAtAQuarterOfTheStabilityLimitWhenTheTangentialSpringIsStiff) {
   // k_s = 1e9 N/m: the tangential ω = sqrt(6 k_s/m) = sqrt(6e9/0.53540739) = 1.0586038e5 s⁻¹,
-  // limit 2/ω = 1.8892810e-5 s, far below t_c/20 = 1.3019180e-4 s: the step is a quarter of it,
-  // 4.7232024e-6 s.
+  // limit 2 / (ω · 1.7001216) = 1.1112622e-5 s (GivenTimeStepIsUsedBelow...), far below
+  // t_c/20 = 1.3019180e-4 s: the step is a quarter of it, 2.7781556e-6 s.
   const MillPlan plan = plan_mill(lab_mill({"materials.ball_ball.tangential_stiffness=1e9",
                                             "materials.ball_wall.tangential_stiffness=1e9"}));
-  EXPECT_HAND(plan.critical_time_step, 1.8892810e-5);
-  EXPECT_HAND(plan.time_step, 4.7232024e-6);
+  EXPECT_HAND(plan.critical_time_step, 1.1112622e-5);
+  EXPECT_HAND(plan.time_step, 2.7781556e-6);
   EXPECT_EQ(plan.time_step, 0.25 * plan.critical_time_step);
 }
 

@@ -184,17 +184,20 @@ TEST(SceneConfig, WarnsOfAGivenTimeStepCoarserThanATenthOfTheShortestContact) {
 }
 
 TEST(SceneConfig, RefusesAnUnstableTimeStepAndGivesTheLimit) {
-  // The limit of docs/model.md ("Time step"), 2/ω_max, for drop's one sphere on its wall:
-  // m = 4000 π/6 0.02³ = 0.016755161 kg (m* = m against a wall); ball–wall k_n = 1e6 N/m and
-  // the default k_s = 2/3 k_n = 666 667 N/m. A sphere (I = 2/5 m r²) adds 1/m + 5/2 m to 1/m_t:
-  // m_t = 2m/7 = 4.7872e-3 kg. ω_n = sqrt(1e6/m) = 7725.5 s⁻¹, ω_t = sqrt(666 667/4.7872e-3) =
-  // 11 801 s⁻¹, the larger: limit 2/11 801 = 1.69479e-4 s, printed with 4 digits as 0.0001695.
+  // The limit of docs/model.md ("Time step"), each mode's 2 / (ω (sqrt(1 + 4 ζ²) + 2 ζ)), for
+  // drop's one sphere on its wall: m = 4000 π/6 0.02³ = 0.016755161 kg (m* = m against a wall);
+  // ball–wall k_n = 1e6 N/m, the default k_s = 2/3 k_n = 666 667 N/m and e = 0.6, ζ = 0.16049305.
+  // A sphere (I = 2/5 m r²) adds 1/m + 5/2 m to 1/m_t: m_t = 2m/7 = 4.7872e-3 kg, and the
+  // tangential ratio is ζ sqrt(m/m_t) = ζ sqrt(3.5) = 0.30025500. ω_n = sqrt(1e6/m) =
+  // 7725.484 s⁻¹: limit 2/(7725.484 · 1.37124) = 1.88795e-4 s; ω_t = sqrt(666 667/4.7872e-3) =
+  // 11 800.87 s⁻¹: limit 2/(11 800.87 · (sqrt(1 + 4 · 0.300255²) + 2 · 0.300255)) =
+  // 2/(11 800.87 · 1.76696) = 9.59154e-5 s, the shorter, printed with 4 digits as 9.592e-05.
   // The shortest contact is AutoTimeStepIsATwentiethOfTheShortestContact's t_c = 4.1199387e-4 s
   // (0.000412), and 1/20 of it 2.0599693e-5 s (2.06e-05).
   expect_refused(drop, {"simulation.time_step=1e-3"},
                  {"command line (--set simulation.time_step=1e-3): simulation.time_step: 0.001 s "
                   "is unstable for these particles and materials (the shortest contact lasts "
-                  "0.000412 s); allowed: a time step below the stability limit 0.0001695 s, and "
+                  "0.000412 s); allowed: a time step below the stability limit 9.592e-05 s, and "
                   "for accuracy about 2.06e-05 s (1/20 of the contact), or \"auto\""});
 }
 

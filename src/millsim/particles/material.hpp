@@ -31,9 +31,12 @@ double tangential_damping(const ContactMaterial& material, double effective_mass
 /// t_c = π / sqrt(k_n/m* − (c_n / 2m*)²), the duration of a normal impact.
 double contact_duration(const ContactMaterial& material, double effective_mass);
 
-/// Largest stable leapfrog step for a two-body contact: 2/ω_max, where ω_max is the larger of
-/// the normal frequency sqrt(k_n/m*) and the tangential one sqrt(k_s/m_t*), m_t* being the
-/// mass that resists sliding once rotation is counted (`tangential_mass`).
+/// Largest stable leapfrog step for a two-body contact: the shorter of the normal mode's and the
+/// tangential mode's 2 / (ω (sqrt(1 + 4 ζ²) + 2 ζ)), with ω = sqrt(k_n/m*) and ζ the damping
+/// ratio, and ω = sqrt(k_s/m_t*) and ζ sqrt(m*/m_t*), m_t* being the mass that resists sliding
+/// once rotation is counted (`tangential_mass`). Undamped (e = 1) it is 2/ω_max; the dashpots,
+/// given the velocity estimated at the time of the positions, lower it (to 0.73 of that for
+/// the normal mode at e = 0.6, 0.59 for a disc's tangential one: docs/model.md).
 double critical_time_step(const ContactMaterial& material, double effective_mass,
                           double tangential_mass);
 

@@ -71,12 +71,14 @@ double cone_bed_volume(double radius, double trunnion_radius, double cone_length
 std::optional<std::string> coarse_step_warning(const std::string& where, double time_step,
                                                double shortest, double automatic) {
   if (!(time_step * fewest_steps_per_contact > shortest)) return std::nullopt;
+  // "auto" is 1/20 of the contact unless a quarter of the stability limit is shorter.
+  const std::string share = automatic < shortest / steps_per_contact
+                                ? std::string("a quarter of the stability limit")
+                                : fmt::format("1/{:.0f} of it", steps_per_contact);
   return fmt::format(
       "{}: simulation.time_step: {:.4g} s resolves the shortest contact ({:.3g} s) in {:.3g} "
-      "steps, fewer than {:.0f}: the results may be inaccurate (\"auto\" takes {:.3g} s, 1/{:.0f} "
-      "of it)",
-      where, time_step, shortest, shortest / time_step, fewest_steps_per_contact, automatic,
-      steps_per_contact);
+      "steps, fewer than {:.0f}: the results may be inaccurate (\"auto\" takes {:.3g} s, {})",
+      where, time_step, shortest, shortest / time_step, fewest_steps_per_contact, automatic, share);
 }
 
 namespace {
@@ -274,6 +276,10 @@ MillPlan plan_mill(const MillConfig& config) {
   const double accurate =
       std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall) /
       steps_per_contact;
+  // "auto": 1/20 of the shortest contact, and never above a quarter of the stability limit
+  // (with a tangential stiffness far above the normal one, or heavy damping, the limit is the
+  // shorter).
+  const double automatic = std::min(accurate, 0.25 * plan.critical_time_step);
   if (config.time_step) {
     if (*config.time_step >= plan.critical_time_step) {
       throw InputError(fmt::format(
@@ -287,13 +293,11 @@ MillPlan plan_mill(const MillConfig& config) {
     const double shortest =
         std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall);
     if (auto warning = coarse_step_warning(config.location_of("simulation.time_step"),
-                                           plan.time_step, shortest, accurate)) {
+                                           plan.time_step, shortest, automatic)) {
       plan.warnings.push_back(std::move(*warning));
     }
   } else {
-    // 1/20 of the shortest contact, and never above a quarter of the stability limit: with a
-    // tangential stiffness far above the normal one the tangential oscillation is the faster.
-    plan.time_step = std::min(accurate, 0.25 * plan.critical_time_step);
+    plan.time_step = automatic;
   }
   if (!(std::isfinite(plan.time_step) && plan.time_step > 0.0)) {
     // Only extreme stiffnesses and masses get here: the contact's frequency overflows.
