@@ -46,6 +46,8 @@
 
 namespace {
 
+using millsim::Allowed;
+using millsim::limit_text;
 using millsim::MillConfig;
 using millsim::MillPlan;
 using millsim::MillResult;
@@ -227,8 +229,9 @@ int scene_info(const millsim::SceneConfig& scene) {
       fmt::join(std::span(scene.gravity).first(static_cast<std::size_t>(scene.dimension)), ", "));
   if (plan.shortest_contact > 0.0) {
     fmt::print("shortest contact      {:.4g} s\n", plan.shortest_contact);
-    fmt::print("time step             {:.4g} s{} (stability limit {:.4g} s)\n", plan.time_step,
-               scene.time_step ? "" : " (auto)", plan.critical_time_step);
+    fmt::print("time step             {:.4g} s{} (stability limit {} s)\n", plan.time_step,
+               scene.time_step ? "" : " (auto)",
+               limit_text(plan.critical_time_step, Allowed::below));
   } else {
     fmt::print("shortest contact      none (nothing can touch)\n");
     fmt::print("time step             {:.4g} s{}\n", plan.time_step,
@@ -300,8 +303,8 @@ int info_command(const JobOptions& options) {
              plan.mill_charge_mass, plan.power_scale);
   fmt::print("contact duration      ball-ball {:.4g} s, ball-wall {:.4g} s (smallest balls)\n",
              plan.contact_duration_ball_ball, plan.contact_duration_ball_wall);
-  fmt::print("time step             {:.4g} s{} (stability limit {:.4g} s)\n", plan.time_step,
-             c.time_step ? "" : " (auto)", plan.critical_time_step);
+  fmt::print("time step             {:.4g} s{} (stability limit {} s)\n", plan.time_step,
+             c.time_step ? "" : " (auto)", limit_text(plan.critical_time_step, Allowed::below));
   const double steps = plan.total_time / plan.time_step;
   fmt::print(
       "simulated time        {:.4g} s: settle {} s, then {} {} from a spin-up of {:.4g} s; "

@@ -191,8 +191,9 @@ TEST_F(Cli, RefusesATimeStepAboveTheStabilityLimitAndGivesTheLimit) {
   //              = 1.1932e-3 s; m_t = m/6, ω_t = sqrt(266 667 × 6/0.53540739) = 1728.69 s⁻¹,
   //              limit 2/(1728.69 · 1.70012) = 6.80506e-4 s;
   //   disc–wall: m* = m and m_t = m/3, ω √2 times lower: limits √2 times longer.
-  // The limit, 6.80506e-4 s, printed with 4 digits as 0.0006805.
-  const std::string limit = "0.0006805";
+  // The limit, 6.8050636e-4 s, printed in the fewest digits from six that do not read as
+  // above it: 0.000680506.
+  const std::string limit = "0.000680506";
   const std::string text = with(base_config, "time_step", "time_step = 0.01");
   const Outcome o = run_config(text, tiny_run);
   expect_refused(o, {at_line(text, "time_step"), "simulation.time_step", "0.01 s is unstable",
@@ -318,7 +319,7 @@ TEST_F(Cli, RefusesLiftersSoCloseThatABallCouldTouchOneBeyondTheNeighbours) {
            "ball_diameter", "ball_diameter = 0.08");
   expect_refused(run_config(dense),
                  {at_line(dense, "count"), "mill.lifters.count",
-                  "a ball wider than 0.07414 m can touch a lifter beyond the two neighbours",
+                  "a ball wider than 0.0741442 m can touch a lifter beyond the two neighbours",
                   "the largest ball is 0.08 m",
                   "allowed: fewer, lower or narrower lifters, or smaller balls"});
   // Balls of 7 cm: accepted.

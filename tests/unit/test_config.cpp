@@ -313,6 +313,9 @@ TEST(Config, RefusesABlankCaseNameAndATolerancePastOne) {
   expect_has(error_of(base_config, {"reference.case=\" \"", "reference.measured_power_kw=1"}),
              {"command line (--set reference.case=\" \")", "reference.case", "\" \" is not allowed",
               "more than blanks"});
+  // Any white space is blank (a newline was taken as a name), and shown escaped.
+  expect_has(error_of(base_config, {"reference.case=\"\\n\\t\"", "reference.measured_power_kw=1"}),
+             {"reference.case", "\"\\n\\t\" is not allowed", "more than blanks"});
   expect_has(error_of(base_config, {"reference.case=x", "reference.measured_power_kw=1",
                                     "reference.tolerance=100"}),
              {"reference.tolerance", "100 is not allowed", "at most 1 (100 %)"});
@@ -355,7 +358,13 @@ TEST(Config, RefusesBothSpeeds) {
   const std::string text = with(base_config, "speed", "speed = 0.5\nspeed_rpm = 20");
   expect_has(error_of(text), {at_line(text, "speed_rpm"), "mill.speed_rpm",
                               "given as well as mill.speed (" + at_line(text, "speed =") + ")",
-                              "allowed: either mill.speed", "not both"});
+                              "allowed: either mill.speed", "not both",
+                              "mill.speed_rpm (a number of rpm > 0, at most 5 times the critical "
+                              "speed)"});
+  // A speed_rpm alone says the same (the bound of 5 times critical is checked by plan_mill).
+  const std::string zero = with(base_config, "speed", "speed_rpm = 0");
+  expect_has(error_of(zero), {at_line(zero, "speed_rpm"), "mill.speed_rpm: 0 is not allowed",
+                              "allowed: a number of rpm > 0, at most 5 times the critical speed"});
 }
 
 TEST(Config, RefusesNoSpeed) {

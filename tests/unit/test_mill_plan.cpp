@@ -194,6 +194,11 @@ TEST(MillPlan, GivenTimeStepIsUsedBelowTheStabilityLimitAndRefusedAboveIt) {
   EXPECT_HAND(plan.critical_time_step, 6.4158756e-4);
   EXPECT_EQ(plan_mill(lab_mill({"simulation.time_step=6.4e-4"})).time_step, 6.4e-4);
   EXPECT_THROW(plan_mill(lab_mill({"simulation.time_step=6.5e-4"})), InputError);
+  // The limit as messages and `info` print it is allowed (in four digits it read 0.0006416, which
+  // is above it and was refused).
+  const std::string printed = limit_text(plan.critical_time_step, Allowed::below);
+  EXPECT_EQ(printed, "0.0006415875");
+  EXPECT_NO_THROW(plan_mill(lab_mill({"simulation.time_step=" + printed})));
 }
 
 TEST(MillPlan, AGivenTimeStepOfFewerThanTenStepsPerContactIsRunWithAWarning) {
@@ -329,6 +334,13 @@ TEST(MillPlan, RefusesMillsThatCannotRunNamingTheKey) {
   // 2.6143604 s: 17.013 s, at 1e-9 s a step 1.70e10 steps.
   expect_has(plan_error(lab_mill({"simulation.time_step=1e-9"})),
              {"simulation.revolutions", "1.7e+10 steps", "at most 1e+10 steps"});
+  // Just past the limit, the count is not rounded to the limit itself ("1e+10 steps; allowed:
+  // at most 1e+10 steps" once), nor a charge just short of half a disc to half a disc: 0.0019911
+  // of the example's 75.33 discs at J = 0.3 is 0.49997 of one.
+  EXPECT_EQ(step_count_text(1.7e10, 1e10), "1.7e+10");
+  EXPECT_EQ(step_count_text(1.0000001e10, 1e10), "1.0000001e+10");
+  expect_has(plan_error(lab_mill({"charge.filling=0.0019911"})),
+             {"charge.filling: this charge is 0.4999", "rounds to none"});
   // A subnormal step overflows the count, which once read "inf steps".
   expect_has(plan_error(lab_mill({"simulation.time_step=1e-310"})),
              {"simulation.revolutions", "is more than 1.7e+308 steps", "at most 1e+10 steps"});

@@ -191,13 +191,14 @@ TEST(SceneConfig, RefusesAnUnstableTimeStepAndGivesTheLimit) {
   // tangential ratio is ζ sqrt(m/m_t) = ζ sqrt(3.5) = 0.30025500. ω_n = sqrt(1e6/m) =
   // 7725.484 s⁻¹: limit 2/(7725.484 · 1.37124) = 1.88795e-4 s; ω_t = sqrt(666 667/4.7872e-3) =
   // 11 800.87 s⁻¹: limit 2/(11 800.87 · (sqrt(1 + 4 · 0.300255²) + 2 · 0.300255)) =
-  // 2/(11 800.87 · 1.76696) = 9.59154e-5 s, the shorter, printed with 4 digits as 9.592e-05.
+  // 2/(11 800.87 · 1.76696) = 9.5915432e-5 s, the shorter, printed as 9.59154e-05 (six digits
+  // that do not read as above it).
   // The shortest contact is AutoTimeStepIsATwentiethOfTheShortestContact's t_c = 4.1199387e-4 s
   // (0.000412), and 1/20 of it 2.0599693e-5 s (2.06e-05).
   expect_refused(drop, {"simulation.time_step=1e-3"},
                  {"command line (--set simulation.time_step=1e-3): simulation.time_step: 0.001 s "
                   "is unstable for these particles and materials (the shortest contact lasts "
-                  "0.000412 s); allowed: a time step below the stability limit 9.592e-05 s, and "
+                  "0.000412 s); allowed: a time step below the stability limit 9.59154e-05 s, and "
                   "for accuracy about 2.06e-05 s (1/20 of the contact), or \"auto\""});
 }
 

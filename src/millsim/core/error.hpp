@@ -36,9 +36,13 @@ inline std::string limit_text(double limit, Allowed allowed) {
 /// A count of time steps computed from the user's values, for a refusal: "1.7e+13", or "more
 /// than 1.7e+308" when it overflowed (a time step of 1e-310 s gave "inf steps"; a double
 /// overflows from about 1.798e308).
-inline std::string step_count_text(double count) {
-  if (std::isfinite(count)) return fmt::format("{:.3g}", count);
-  return "more than 1.7e+308";
+inline std::string step_count_text(double count, double most) {
+  if (!std::isfinite(count)) return "more than 1.7e+308";
+  // Three digits, unless they would read as allowed: 1.0000001e10 against at most 1e10.
+  const std::string text = fmt::format("{:.3g}", count);
+  double read = 0.0;
+  std::from_chars(text.data(), text.data() + text.size(), read);
+  return count > most && read <= most ? limit_text(count, Allowed::above) : text;
 }
 
 }  // namespace millsim

@@ -241,7 +241,8 @@ void read_mill(TableReader section, MillConfig& config) {
   config.length = section.number("length", std::nullopt, "a number of metres > 0, at most 1000",
                                  [](double l) { return l > 0.0 && l <= 1000.0; });
   const std::string speed_rule = "a fraction of critical speed > 0, at most 5";
-  const std::string rpm_rule = "a number of rpm > 0";
+  // (The rpm's upper bound depends on the critical speed, which plan_mill works out and checks.)
+  const std::string rpm_rule = "a number of rpm > 0, at most 5 times the critical speed";
   config.speed_fraction =
       section.optional_number("speed", speed_rule, [](double s) { return s > 0.0 && s <= 5.0; });
   config.speed_rpm = section.optional_number("speed_rpm", rpm_rule, positive);
@@ -408,9 +409,9 @@ void read_reference(TableReader section, MillConfig& config) {
                      belongs_elsewhere);
   ReferencePower r;
   r.case_name = section.string("case", std::nullopt, "the case name (a string)");
-  if (r.case_name.find_first_not_of(" \t") == std::string::npos) {
-    // It names the case's row of validate's table.
-    section.fail_at("case", fmt::format("\"{}\" is not allowed; allowed: the case name, a string "
+  if (r.case_name.find_first_not_of(" \t\n\v\f\r") == std::string::npos) {
+    // It names the case's row of validate's table. (Quoted with its escapes: a tab as \t.)
+    section.fail_at("case", fmt::format("{:?} is not allowed; allowed: the case name, a string "
                                         "with more than blanks (e.g. \"2D-a\")",
                                         r.case_name));
   }

@@ -162,11 +162,11 @@ MillPlan plan_mill(const MillConfig& config) {
     if (plan.largest_ball > widest) {
       throw InputError(fmt::format(
           "{}: mill.lifters.count: with {} lifters {} m high and {} m wide a ball wider than "
-          "{:.4g} m can touch a lifter beyond the two neighbours of its nearest one, which "
+          "{} m can touch a lifter beyond the two neighbours of its nearest one, which "
           "millsim does not test, and the largest ball is {} m; allowed: fewer, lower or "
           "narrower lifters, or smaller balls, so that the largest ball is at most that wide",
           config.location_of("mill.lifters.count"), config.lifter_count, config.lifter_height,
-          config.lifter_width, widest, plan.largest_ball));
+          config.lifter_width, limit_text(widest, Allowed::below), plan.largest_ball));
     }
   }
   if (config.periodic && config.slab_length < 3.0 * plan.largest_ball) {
@@ -244,10 +244,10 @@ MillPlan plan_mill(const MillConfig& config) {
   }
   if (!(total >= 0.5)) {
     throw InputError(fmt::format(
-        "{}: charge.filling: this charge is {:.3g} of a {}, which rounds to none; allowed: a "
-        "filling, mill and ball sizes whose charge holds at least one (set by {})",
-        config.location_of("charge.filling"), total, config.dimension == 2 ? "disc" : "ball",
-        count_keys));
+        "{}: charge.filling: this charge is {} of a {}, which rounds to none; allowed: a "
+        "filling, mill and ball sizes whose charge holds at least half of one (set by {})",
+        config.location_of("charge.filling"), limit_text(total, Allowed::below),
+        config.dimension == 2 ? "disc" : "ball", count_keys));
   }
   for (std::size_t k = 0; k < counts.size(); ++k) {
     plan.discs[k].count = std::max(1, static_cast<int>(std::lround(counts[k])));
@@ -284,10 +284,11 @@ MillPlan plan_mill(const MillConfig& config) {
     if (*config.time_step >= plan.critical_time_step) {
       throw InputError(fmt::format(
           "{}: simulation.time_step: {:.4g} s is unstable for these materials and balls (the "
-          "stability limit is {:.4g} s; for accuracy about {:.3g} s, 1/{} of the shortest "
-          "contact); allowed: \"auto\" or a number of seconds below {:.4g}",
-          config.location_of("simulation.time_step"), *config.time_step, plan.critical_time_step,
-          accurate, steps_per_contact, plan.critical_time_step));
+          "stability limit is {} s; for accuracy about {:.3g} s, 1/{} of the shortest "
+          "contact); allowed: \"auto\" or a number of seconds below {}",
+          config.location_of("simulation.time_step"), *config.time_step,
+          limit_text(plan.critical_time_step, Allowed::below), accurate, steps_per_contact,
+          limit_text(plan.critical_time_step, Allowed::below)));
     }
     plan.time_step = *config.time_step;
     const double shortest =
@@ -319,7 +320,7 @@ MillPlan plan_mill(const MillConfig& config) {
         "revolutions, a shorter settle_time, a faster mill.speed, or a longer "
         "simulation.time_step)",
         config.location_of("simulation.revolutions"), config.settle_time, config.revolutions,
-        plan.revolution_period, plan.time_step, step_count_text(steps), most_steps));
+        plan.revolution_period, plan.time_step, step_count_text(steps, most_steps), most_steps));
   }
   if (config.snapshot_interval > 0.0 && config.snapshot_interval < plan.time_step) {
     throw InputError(fmt::format(

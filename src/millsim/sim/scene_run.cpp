@@ -160,9 +160,9 @@ ScenePlan plan_scene(const SceneConfig& config) {
       throw InputError(fmt::format(
           "{}: simulation.time_step: {:.4g} s is unstable for these particles and materials "
           "(the shortest contact lasts {:.4g} s); allowed: a time step below the stability "
-          "limit {:.4g} s, and for accuracy about {:.4g} s (1/{} of the contact), or \"auto\"",
-          config.location_of("simulation.time_step"), *config.time_step, shortest, critical,
-          shortest / steps_per_contact, steps_per_contact));
+          "limit {} s, and for accuracy about {:.4g} s (1/{} of the contact), or \"auto\"",
+          config.location_of("simulation.time_step"), *config.time_step, shortest,
+          limit_text(critical, Allowed::below), shortest / steps_per_contact, steps_per_contact));
     }
     plan.time_step = *config.time_step;
     // (Particles that can touch nothing have an infinite shortest contact: no warning.)
@@ -191,7 +191,7 @@ ScenePlan plan_scene(const SceneConfig& config) {
         "{}: simulation.duration: {} s at a time step of {:.4g} s is {} steps; allowed: at "
         "most {:.0e} steps (shorten the duration or lengthen the time step)",
         config.location_of("simulation.duration"), config.duration, plan.time_step,
-        step_count_text(exact), most_steps));
+        step_count_text(exact, most_steps), most_steps));
   }
   if (exact < 1.0) {
     // One step would run past the end by more than the duration itself: two balls of 100 m at
