@@ -352,6 +352,27 @@ TEST(MillWall, EveryLifterADiscTouchesIsFoundUpToTheWidestParticleForTheLifters)
   }
 }
 
+TEST(MillWall, LiftersWhoseInnerCornersAlmostMeetMissNoContact) {
+  // The config allows lifters up to the width at which neighbours' inner corners meet,
+  // 2 (R − h) tan(π/n). Eight lifters 5 cm high in a 1 m mill at 0.999 of it (0.3724 m wide,
+  // 0.3 mm apart at the corners), discs of the widest size the lifters allow: the search finds
+  // every lifter each one overlaps, the two whose corners nearly meet included; and small discs
+  // (2 cm), which can touch both lifters where their corners nearly meet.
+  Mill2D mill;
+  mill.radius = 0.5;
+  mill.lifter_count = 8;
+  mill.lifter_height = 0.05;
+  mill.lifter_width = 0.999 * 2.0 * (mill.radius - mill.lifter_height) * std::tan(pi / 8.0);
+  mill.turn_to(0.3);
+  const double widest = widest_particle_for_lifters(mill.radius, 8, 0.05, mill.lifter_width);
+  std::mt19937_64 random(11);
+  for (const double diameter : {widest, 0.02}) {
+    const auto [missed, touching] = lifter_contacts_missed(mill, diameter, random);
+    EXPECT_EQ(missed, 0) << "discs " << diameter << " m wide";
+    EXPECT_GT(touching, 1000) << "discs " << diameter << " m wide: too few touched a lifter";
+  }
+}
+
 // ---- Determinism ---------------------------------------------------------------------------
 
 TEST(MillWall, TheExampleMillRunsBitForBitTheSameTwice) {

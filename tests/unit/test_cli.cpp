@@ -256,12 +256,13 @@ TEST_F(Cli, RefusesAFillingOfOneOrMore) {
 }
 
 TEST_F(Cli, RefusesLiftersThatOverlap) {
-  const std::string text = with(base_config, "width", "width = 0.33");
-  expect_refused(run_config(text),
-                 {at_line(text, "width"), "mill.lifters.width", "0.33 is not allowed", "overlap"});
-  // The limit, 2π (0.45 − 0.04) / 8 = 0.32201324699295 m, in six digits (below it).
-  const std::string past_limit = with(base_config, "width", "width = 0.32202");
-  expect_refused(run_config(past_limit), {"0.32202 is not allowed", "> 0 and < 0.322013 ("});
+  const std::string text = with(base_config, "width", "width = 0.34");
+  expect_refused(run_config(text), {at_line(text, "width"), "mill.lifters.width",
+                                    "0.34 is not allowed", "inner corners", "would meet"});
+  // The limit, where neighbours' inner corners meet, 2 (0.45 − 0.04) tan(π/8) =
+  // 0.33965512114593793 m, in six digits (below it).
+  const std::string past_limit = with(base_config, "width", "width = 0.339656");
+  expect_refused(run_config(past_limit), {"0.339656 is not allowed", "> 0 and < 0.339655 ("});
 }
 
 TEST_F(Cli, RefusesLiftersThatFillTheMill) {

@@ -346,12 +346,19 @@ TEST(Config, RefusesLiftersThatFillTheMill) {
 }
 
 TEST(Config, RefusesLiftersThatOverlap) {
-  // 8 lifters 4 cm high: the inner circumference 2π (0.45 − 0.04) = 2.576 m gives each 0.322 m.
-  const std::string text = with(base_config, "width", "width = 0.33");
-  expect_has(error_of(text), {at_line(text, "width"), "mill.lifters.width", "0.33 is not allowed",
-                              "< 0.322", "overlap"});
-  EXPECT_EQ(parse_mill_config(with(base_config, "width", "width = 0.32"), file_name).lifter_width,
-            0.32);
+  // 8 lifters 4 cm high: neighbours, 45° apart, meet where their inner corners do, at
+  // w = 2 (0.45 − 0.04) tan(22.5°) = 0.3396551 m. (Until 2026-12-07 the limit was the inner
+  // circle's share, 2π (0.45 − 0.04) / 8 = 0.322 m, which refused lifters 9 mm apart.)
+  const std::string text = with(base_config, "width", "width = 0.34");
+  expect_has(error_of(text), {at_line(text, "width"), "mill.lifters.width", "0.34 is not allowed",
+                              "< 0.339655", "inner corners of 8 lifters 0.04 m high would meet"});
+  EXPECT_EQ(parse_mill_config(with(base_config, "width", "width = 0.33"), file_name).lifter_width,
+            0.33);
+  // Two lifters cannot meet: the width is bounded by each one's share of the inner circle,
+  // π (0.45 − 0.04) = 1.288053 m.
+  const std::string two = with(with(base_config, "count", "count = 2"), "width", "width = 1.3");
+  expect_has(error_of(two), {at_line(two, "width"), "1.3 is not allowed", "< 1.28805",
+                             "the inner circle's share of each of 2 lifters"});
 }
 
 TEST(Config, RefusesBothSpeeds) {

@@ -159,13 +159,21 @@ void read_lifters(TableReader lifters, MillConfig& config) {
   config.lifter_height = lifters.number(
       "height", std::nullopt,
       fmt::format("{}; needed because count = {}", height_rule, config.lifter_count), height_fits);
-  const double inner_circumference = 2.0 * pi * (radius - config.lifter_height);
-  const double widest = inner_circumference / config.lifter_count;
+  // Neighbouring bars, 2π/n apart, meet where their inner faces' corners do, on the ray
+  // between them: at w = 2 (R − h) tan(π/n). (Two or one cannot meet: for them the inner
+  // circle's share of each, 2π (R − h) / n, bounds the width.)
+  const double inner_radius = radius - config.lifter_height;
+  const int count = config.lifter_count;
+  const double widest =
+      count >= 3 ? 2.0 * inner_radius * std::tan(pi / count) : 2.0 * pi * inner_radius / count;
+  const std::string why =
+      count >= 3 ? fmt::format("wider, the inner corners of {} lifters {} m high would meet", count,
+                               config.lifter_height)
+                 : fmt::format("the inner circle's share of each of {} lifters {} m high", count,
+                               config.lifter_height);
   config.lifter_width = lifters.number(
       "width", std::nullopt,
-      fmt::format("a number of metres > 0 and < {} (wider, {} lifters {} m high would "
-                  "overlap at their inner faces)",
-                  limit_text(widest, Allowed::below), config.lifter_count, config.lifter_height),
+      fmt::format("a number of metres > 0 and < {} ({})", limit_text(widest, Allowed::below), why),
       [&](double w) { return w > 0.0 && w < widest; });
 }
 
