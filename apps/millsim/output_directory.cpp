@@ -43,21 +43,28 @@ constexpr std::string_view longest_snapshot_file = "snapshots/snapshot_000000000
 
 void refuse_a_path_too_long(const fs::path& out, const std::string& location,
                             std::initializer_list<const char*> results, Snapshots snapshots) {
-  std::string longest = std::string(aside_prefix) + "XXXXXX";
+  // What the run writes in `out`, and what it moves aside there, into the directory made for an
+  // earlier run's results (its .partial files and snapshots/ too), where they are removed: the
+  // longest of these must fit, so that a directory a run could write can be run into again.
+  const std::string aside = std::string(aside_prefix) + "XXXXXX";
+  std::string longest = aside;
+  const auto consider = [&longest](std::string name) {
+    if (name.size() > longest.size()) longest = std::move(name);
+  };
   for (const char* name : results) {
-    std::string partial = std::string(name) + ".partial";
-    if (partial.size() > longest.size()) longest = std::move(partial);
+    consider(std::string(name) + ".partial");
+    consider(aside + "/" + name + ".partial");
   }
-  if (snapshots == Snapshots::made && longest_snapshot_file.size() > longest.size()) {
-    longest = longest_snapshot_file;
-  }
+  if (snapshots == Snapshots::made) consider(std::string(longest_snapshot_file));
+  if (snapshots != Snapshots::untouched) consider(aside + "/" + std::string(longest_snapshot_file));
   constexpr std::size_t most = PATH_MAX - 1;  // the system's limit, the terminating zero aside
   const std::size_t written = (out / longest).string().size();
   if (written <= most) return;
   throw millsim::InputError(fmt::format(
       "{}: output.directory: a path of {} characters leaves no room for the files the run "
-      "writes in it (its {} would be a path of {}); allowed: a directory path of at most {} "
-      "characters (the system takes paths of at most {})",
+      "writes in it, or moves aside there from an earlier run (the longest, {}, would be a path "
+      "of {}); allowed: a directory path of at most {} characters (the system takes paths of at "
+      "most {})",
       location, out.string().size(), longest, written, most - (written - out.string().size()),
       most));
 }

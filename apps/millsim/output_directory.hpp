@@ -23,11 +23,12 @@ void refuse_a_file_as_directory(const std::filesystem::path& out, const std::str
 enum class Snapshots { untouched, removed, made };
 
 /// Refuses (InputError) an output directory whose path leaves no room for the longest path a
-/// run makes in it: the directory the earlier results are moved aside into, a result's
-/// NAME.partial, or, if `snapshots` is made, a snapshot's. Without this, a path just under the
-/// system's limit passed every check and the run failed at its first snapshot, after the charge
-/// had settled. (An earlier result moved aside is one level deeper still: a rename that cannot
-/// be made is a refusal that loses nothing.) Checked by check_output_directory and
+/// run makes in it: a result's NAME.partial, if `snapshots` is made a snapshot's, and an
+/// earlier run's results moved aside into .millsim-earlier-results-XXXXXX/ (a NAME.partial,
+/// and unless untouched a snapshot in snapshots/), where they are removed. Without this, a path
+/// just under the system's limit passed every check and the run failed at its first snapshot,
+/// after the charge had settled; and a directory a run had written could not be run into again
+/// (the earlier results could not be moved aside). Checked by check_output_directory and
 /// prepare_output_directory; a sweep checks each point's directory with it before any runs.
 void refuse_a_path_too_long(const std::filesystem::path& out, const std::string& location,
                             std::initializer_list<const char*> results, Snapshots snapshots);

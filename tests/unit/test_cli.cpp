@@ -623,57 +623,83 @@ std::string long_path(int directories, std::size_t last) {
 
 TEST_F(Cli, AResultThatCannotBeMovedAsideRefusesTheRunAndPutsBackThoseThatWere) {
   // The earlier results are renamed into out/.millsim-earlier-results-XXXXXX/ before they are
-  // removed. A path of 4046 characters leaves room for out/power_timeseries.csv (4067) but not
-  // for it moved aside (4099, beyond the system's 4095): summary.json and power.csv are moved
-  // first, then that rename fails, and they must be put back.
+  // removed, and so is anything in out/ whose name starts as that directory's does (what a
+  // clearing that was stopped left). A path of 4000 characters has room for everything a run
+  // writes or moves aside (AnOutputPathWithNoRoom...), but not for a file of 80 characters of
+  // that kind moved aside (4113, beyond the system's 4095): summary.json and power.csv are
+  // moved first, then that rename fails, and they must be put back.
   write_config(base_config);
-  const std::string out = long_path(19, 227);
-  ASSERT_EQ(out.size(), 4046U);
+  const std::string out = long_path(19, 181);
+  ASSERT_EQ(out.size(), 4000U);
   ASSERT_EQ(millsim("run mill.toml -q -o " + out + " " + tiny_run).status, 0);
   const std::string summary = read_all(work_ / out / "summary.json");
   const std::string power = read_all(work_ / out / "power.csv");
+  ASSERT_FALSE(summary.empty());
+  ASSERT_FALSE(power.empty());
+  const std::string left = ".millsim-earlier-results-" + std::string(55, 'c');
+  ASSERT_EQ(left.size(), 80U);
+  // (Made from the working directory: with it, the path is beyond the system's limit.)
+  ASSERT_EQ(std::system(("cd " + quoted(work_.string()) + " && : > " + out + "/" + left).c_str()),
+            0);
   const Outcome again = millsim("run mill.toml -q -o " + out + " " + tiny_run);
   EXPECT_EQ(again.status, 2) << again.err;
   EXPECT_NE(again.err.find("cannot clear earlier results from"), std::string::npos) << again.err;
-  EXPECT_NE(again.err.find("(power_timeseries.csv: File name too long)"), std::string::npos)
-      << again.err;
+  EXPECT_NE(again.err.find("(" + left + ": File name too long)"), std::string::npos) << again.err;
   EXPECT_EQ(read_all(work_ / out / "summary.json"), summary);
   EXPECT_EQ(read_all(work_ / out / "power.csv"), power);
   for (const auto& entry : fs::directory_iterator(work_ / out)) {
-    EXPECT_FALSE(entry.path().filename().string().starts_with(".millsim")) << entry.path();
+    const std::string name = entry.path().filename().string();
+    if (name.starts_with(".millsim")) {
+      EXPECT_EQ(name, left) << "left behind: " << name;
+    }
   }
 }
 
-TEST_F(Cli, AnOutputPathWithNoRoomForTheSnapshotsIsRefusedBeforeTheRun) {
-  // 4060 characters: room for out/power_timeseries.csv.partial (4089 of the system's 4095), none
-  // for out/snapshots/snapshot_0000000000.csv.partial (4102). Such a run once settled its charge
-  // and then failed at its first snapshot (exit 1).
+TEST_F(Cli, AnOutputPathWithNoRoomForWhatTheRunWritesOrMovesAsideIsRefusedBeforeTheRun) {
+  // The longest path a run makes is an earlier run's snapshot moved aside to be removed,
+  // out/.millsim-earlier-results-XXXXXX/snapshots/snapshot_0000000000.csv.partial: 74 more
+  // characters. 4022 characters are refused, with or without snapshots (4096, beyond the
+  // system's 4095). Such a run once settled its charge and then failed at its first snapshot
+  // (exit 1); and a directory of 4043 to 4063 characters could be run into once but not again.
   write_config(base_config);
-  const std::string out = long_path(19, 241);
-  ASSERT_EQ(out.size(), 4060U);
   const std::string short_run =
       " --set simulation.revolutions=1 --set simulation.measure_revolutions=1 "
       "--set simulation.settle_time=0.01 --set output.snapshot_interval=";
-  const Outcome o = millsim("run mill.toml -q -o " + out + short_run + "0.05");
-  EXPECT_EQ(o.status, 2) << o.err;
-  EXPECT_NE(o.err.find("): output.directory: a path of 4060 characters leaves no room for the "
-                       "files the run writes in it (its snapshots/snapshot_0000000000.csv.partial "
-                       "would be a path of 4102); allowed: a directory path of at most 4053 "
-                       "characters (the system takes paths of at most 4095)"),
-            std::string::npos)
-      << o.err;
-  EXPECT_FALSE(fs::exists(work_ / std::string(200, 'a'))) << "nothing is made";
-  // Without snapshots the same directory has room for every result.
+  const std::string too_long = long_path(19, 203);
+  ASSERT_EQ(too_long.size(), 4022U);
+  for (const std::string interval : {"0.05", "0"}) {
+    const Outcome o = millsim("run mill.toml -q -o " + too_long + short_run + interval);
+    EXPECT_EQ(o.status, 2) << o.err;
+    EXPECT_NE(o.err.find("): output.directory: a path of 4022 characters leaves no room for the "
+                         "files the run writes in it, or moves aside there from an earlier run "
+                         "(the longest, .millsim-earlier-results-XXXXXX/snapshots/"
+                         "snapshot_0000000000.csv.partial, would be a path of 4096); allowed: a "
+                         "directory path of at most 4021 characters (the system takes paths of "
+                         "at most 4095)"),
+              std::string::npos)
+        << o.err;
+    EXPECT_FALSE(fs::exists(work_ / std::string(200, 'a'))) << "nothing is made";
+  }
+  // At the limit, a run with snapshots, and again (its results and snapshots moved aside and
+  // removed), and again without snapshots.
   // (work_ / out is beyond the system's limit: the test reads it through the program's output.)
-  const Outcome without = millsim("run mill.toml -q -o " + out + short_run + "0");
-  EXPECT_EQ(without.status, 0) << without.err;
-  EXPECT_TRUE(without.out.starts_with("power ")) << without.out;
+  const std::string out = long_path(19, 202);
+  ASSERT_EQ(out.size(), 4021U);
+  for (const std::string interval : {"0.05", "0.05", "0"}) {
+    const Outcome o = millsim("run mill.toml -q -o " + out + short_run + interval);
+    EXPECT_EQ(o.status, 0) << o.err;
+    EXPECT_TRUE(o.out.starts_with("power ")) << o.out;
+    // (Its one measured revolution takes in the spin-up, which is warned of.)
+    EXPECT_EQ(o.err.find("could not all be removed"), std::string::npos) << o.err;
+    EXPECT_EQ(o.err.find("error"), std::string::npos) << o.err;
+  }
 }
 
 TEST_F(Cli, ASweepRefusesAPointDirectoryWithNoRoomForItsSnapshotsBeforeAnyPointRuns) {
-  // A root of 4040 characters: each point's directory (root/NAME) has room for its results but
-  // not for its snapshots. The sweep once started, wrote sweep.csv and failed every point
-  // (exit 1); it is now refused (exit 2) before anything is made.
+  // A root of 4039 characters: each point's directory (root/NAME) has room for its results but
+  // not for its snapshots, nor for an earlier run's moved aside. The sweep once started, wrote
+  // sweep.csv and failed every point (exit 1); it is now refused (exit 2) before anything is
+  // made.
   write_config(base_config);
   const std::string out = long_path(20, 19);
   ASSERT_EQ(out.size(), 4039U);
@@ -684,8 +710,9 @@ TEST_F(Cli, ASweepRefusesAPointDirectoryWithNoRoomForItsSnapshotsBeforeAnyPointR
   EXPECT_NE(o.err.find("command line (--out " + out + "): output.directory: a path of "),
             std::string::npos)
       << o.err;
-  EXPECT_NE(o.err.find("leaves no room for the files the run writes in it (its "
-                       "snapshots/snapshot_0000000000.csv.partial would be a path of "),
+  EXPECT_NE(o.err.find("leaves no room for the files the run writes in it, or moves aside there "
+                       "from an earlier run (the longest, .millsim-earlier-results-XXXXXX/"
+                       "snapshots/snapshot_0000000000.csv.partial, would be a path of "),
             std::string::npos)
       << o.err;
   EXPECT_FALSE(fs::exists(work_ / std::string(200, 'a'))) << "nothing is made";
