@@ -482,6 +482,12 @@ TEST(Config, RefusesMoreMeasuredRevolutionsThanRun) {
               "±9223372036854775807 if whole"});
   const std::string quoted = error_of(base_config, {"simulation.revolutions=\"5\""});
   expect_has(quoted, {"\"5\" is a string; allowed:"});
+  // A string typed inside an array or table that TOML read was typed as one, too (the message
+  // once said TOML had not read it as a number).
+  const std::string in_array =
+      error_of(base_config, {"charge.sizes=[{diameter = \"0.05\", mass_fraction = 1}]"});
+  EXPECT_EQ(in_array.find("TOML did not read it"), std::string::npos) << in_array;
+  expect_has(in_array, {"charge.sizes", "\"0.05\" is a string"});
 }
 
 TEST(Config, AValidOverrideChangesTheValueAndIsRecordedAsFromTheCommandLine) {

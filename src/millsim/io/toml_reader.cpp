@@ -82,13 +82,13 @@ std::string describe(const toml::node& node) {
 /// "\"0.9\" is a string", "a table is not allowed here": the first half of a type error.
 std::string wrong_type(const toml::node& node) {
   if (const auto* text = node.as_string(); text != nullptr && from_override(node)) {
-    // A --set value TOML could not read is kept as text: say why, where it looks like a number
-    // (and was not typed as a string: --set KEY="0.9").
+    // A --set value TOML could not read is kept as text, all of it: say why, where it looks
+    // like a number (not where a string was typed as one: --set KEY="0.9", or one inside an
+    // array or table that TOML read).
     const std::string_view option = *node.source().path;
     const std::string_view value =
         trim(option.substr(std::min(option.size(), option.find('=') + 1)));
-    const std::string_view typed =
-        value.starts_with('"') || value.starts_with('\'') ? std::string_view() : text->get();
+    const std::string_view typed = text->get() == value ? value : std::string_view();
     const bool digits = !typed.empty() && std::all_of(typed.begin(), typed.end(), [](char c) {
       return std::isdigit(static_cast<unsigned char>(c)) != 0 || c == '+' || c == '-' || c == '.' ||
              c == 'e' || c == 'E' || c == '_';
