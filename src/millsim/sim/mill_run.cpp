@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 #include "millsim/core/constants.hpp"
 #include "millsim/io/output.hpp"
@@ -142,10 +143,13 @@ MillResult run_mill(const MillPlan& plan, World<D> world,
       result.largest_overlap_fraction =
           std::max(result.largest_overlap_fraction, world.largest_overlap_fraction());
       if (measuring) {
-        const auto [centre, angular_speed] = charge_motion(world.particles());
+        // (Read only: the non-const particles() would mark the step's velocity estimates
+        // stale, and the next step would make them again.)
+        const ParticleStore<D>& particles = std::as_const(world).particles();
+        const auto [centre, angular_speed] = charge_motion(particles);
         result.charge_centre += centre;
         result.orbital_speed_ratio += angular_speed / plan.angular_speed;
-        result.charge_profile->add(world.particles().position, world.particles().radius);
+        result.charge_profile->add(particles.position, particles.radius);
         ++motion_samples;
       }
       series_start = now;
