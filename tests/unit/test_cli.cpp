@@ -668,7 +668,8 @@ TEST_F(Cli, AnOutputPathWithNoRoomForWhatTheRunWritesOrMovesAsideIsRefusedBefore
   const std::string too_long = long_path(19, 203);
   ASSERT_EQ(too_long.size(), 4022U);
   for (const std::string interval : {"0.05", "0"}) {
-    const Outcome o = millsim("run mill.toml -q -o " + too_long + short_run + interval);
+    const Outcome o = millsim(
+        std::string("run mill.toml -q -o ").append(too_long).append(short_run).append(interval));
     EXPECT_EQ(o.status, 2) << o.err;
     EXPECT_NE(o.err.find("): output.directory: a path of 4022 characters leaves no room for the "
                          "files the run writes in it, or moves aside there from an earlier run "
@@ -686,7 +687,8 @@ TEST_F(Cli, AnOutputPathWithNoRoomForWhatTheRunWritesOrMovesAsideIsRefusedBefore
   const std::string out = long_path(19, 202);
   ASSERT_EQ(out.size(), 4021U);
   for (const std::string interval : {"0.05", "0.05", "0"}) {
-    const Outcome o = millsim("run mill.toml -q -o " + out + short_run + interval);
+    const Outcome o =
+        millsim(std::string("run mill.toml -q -o ").append(out).append(short_run).append(interval));
     EXPECT_EQ(o.status, 0) << o.err;
     EXPECT_TRUE(o.out.starts_with("power ")) << o.out;
     // (Its one measured revolution takes in the spin-up, which is warned of.)

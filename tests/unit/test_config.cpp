@@ -366,8 +366,8 @@ TEST(Config, RefusesBothSpeeds) {
   expect_has(error_of(text), {at_line(text, "speed_rpm"), "mill.speed_rpm",
                               "given as well as mill.speed (" + at_line(text, "speed =") + ")",
                               "allowed: either mill.speed", "not both",
-                              "mill.speed_rpm (a number of rpm > 0, at most 5 times the critical "
-                              "speed)"});
+                              std::string_view("mill.speed_rpm (a number of rpm > 0, at most 5 "
+                                               "times the critical speed)")});
   // A speed_rpm alone says the same (the bound of 5 times critical is checked by plan_mill).
   const std::string zero = with(base_config, "speed", "speed_rpm = 0");
   expect_has(error_of(zero), {at_line(zero, "speed_rpm"), "mill.speed_rpm: 0 is not allowed",
