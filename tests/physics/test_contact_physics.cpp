@@ -393,9 +393,14 @@ TEST(LeapfrogStability, BoundedJustBelowTheLimitAndGrowingJustAboveIt) {
 // normal one, so the library's limit is the tangential 2/ω. Started with the slip speed ε (the
 // disc sliding, not turning), the slip speed v_x + ω r stays within the leapfrog's invariant
 // bound below the limit and grows by |λ| a step above it.
-double largest_slip_speed_on_floor(double limit_fraction, int steps,
-                                   const ContactMaterial& material = {1.0e6, 1.0e6, 1.0, 10.0}) {
-  const double radius = 0.05, mass = 2.0, nudge = 1e-6;
+constexpr double floor_disc_radius = 0.05, floor_disc_mass = 2.0;
+
+/// A disc of floor_disc_radius and floor_disc_mass resting on the floor under gravity, at the
+/// overlap where the spring carries its weight (m g / k_n), with the velocity `nudge`; the step
+/// is `limit_fraction` of the library's stability limit for the disc on the floor.
+World<2> disc_resting_on_floor(const ContactMaterial& material, double limit_fraction,
+                               const Vec2& nudge) {
+  const double radius = floor_disc_radius, mass = floor_disc_mass;
   WorldSettings<2> settings;
   settings.time_step =
       limit_fraction * critical_time_step(material, mass, tangential_mass(mass, 0.0, 0.5));
@@ -404,9 +409,15 @@ double largest_slip_speed_on_floor(double limit_fraction, int steps,
   Walls<2> walls;
   walls.planes.push_back(Plane<2>{Vec2{{0.0, 0.0}}, Vec2{{0.0, 1.0}}});
   World<2> world(settings, walls);
-  // At the overlap where the spring carries the weight, m g / k_n.
   const double rest = radius - mass * standard_gravity / material.normal_stiffness;
-  world.particles().add(Vec2{{0.0, rest}}, radius, mass, Vec2{{nudge, 0.0}});
+  world.particles().add(Vec2{{0.0, rest}}, radius, mass, nudge);
+  return world;
+}
+
+double largest_slip_speed_on_floor(double limit_fraction, int steps,
+                                   const ContactMaterial& material = {1.0e6, 1.0e6, 1.0, 10.0}) {
+  const double radius = floor_disc_radius, nudge = 1e-6;
+  World<2> world = disc_resting_on_floor(material, limit_fraction, Vec2{{nudge, 0.0}});
   double largest = 0.0;
   for (int n = 0; n < steps; ++n) {
     world.step();
@@ -436,25 +447,16 @@ TEST(LeapfrogStability, TheTangentialLimitBindsWhereItIsTheShorter) {
 // stable for ω Δt < 2 / (sqrt(1 + 4 ζ²) + 2 ζ) (docs/model.md, "Time step"). Below it the
 // motion dies away; just above it the mode grows by nearly 1 + (its distance from the limit) a
 // step. At e = 0.6 the undamped limit 2/ω was 1.37 times too long for the normal mode and 1.70
-// for a disc's tangential one, and a lab mill run at 0.9 of it was off in its energy balance
-// by 1056 % (a review's finding, 2026-12-07).
+// for a disc's tangential one, and the built-in example run at 0.90 of it was off in its
+// energy balance by 951 % (a review's finding, 2026-12-07; docs/model.md).
 
 // The normal mode: a disc resting on the floor under gravity, e = 0.6, its tangential spring
 // soft enough (k_s = k_n / 10) that the normal mode sets the limit, started with the vertical
 // speed ε. Returns the largest vertical speed over ε in `steps` steps, and in the last tenth.
 std::pair<double, double> largest_bounce_speed_on_floor(double limit_fraction, int steps) {
-  const double radius = 0.05, mass = 2.0, nudge = 1e-6;
+  const double nudge = 1e-6;
   const ContactMaterial material{1.0e6, 1.0e5, 0.6, 10.0};
-  WorldSettings<2> settings;
-  settings.time_step =
-      limit_fraction * critical_time_step(material, mass, tangential_mass(mass, 0.0, 0.5));
-  settings.gravity = Vec2{{0.0, -standard_gravity}};
-  settings.ball_wall = material;
-  Walls<2> walls;
-  walls.planes.push_back(Plane<2>{Vec2{{0.0, 0.0}}, Vec2{{0.0, 1.0}}});
-  World<2> world(settings, walls);
-  const double rest = radius - mass * standard_gravity / material.normal_stiffness;
-  world.particles().add(Vec2{{0.0, rest}}, radius, mass, Vec2{{0.0, nudge}});
+  World<2> world = disc_resting_on_floor(material, limit_fraction, Vec2{{0.0, nudge}});
   double largest = 0.0;
   double last = 0.0;
   for (int n = 0; n < steps; ++n) {
