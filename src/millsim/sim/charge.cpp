@@ -273,13 +273,10 @@ MillPlan plan_mill(const MillConfig& config) {
   plan.critical_time_step = std::min(
       critical_time_step(config.ball_ball, pair_mass, tangential_mass(lightest, lightest, inertia)),
       critical_time_step(config.ball_wall, lightest, tangential_mass(lightest, 0.0, inertia)));
-  const double accurate =
-      std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall) /
-      steps_per_contact;
-  // "auto": 1/20 of the shortest contact, and never above a quarter of the stability limit
-  // (with a tangential stiffness far above the normal one, or heavy damping, the limit is the
-  // shorter).
-  const double automatic = std::min(accurate, 0.25 * plan.critical_time_step);
+  const double shortest =
+      std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall);
+  const double accurate = shortest / steps_per_contact;
+  const double automatic = automatic_time_step(shortest, plan.critical_time_step);
   if (config.time_step) {
     if (*config.time_step >= plan.critical_time_step) {
       throw InputError(fmt::format(
@@ -291,8 +288,6 @@ MillPlan plan_mill(const MillConfig& config) {
           limit_text(plan.critical_time_step, Allowed::below)));
     }
     plan.time_step = *config.time_step;
-    const double shortest =
-        std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall);
     if (auto warning = coarse_step_warning(config.location_of("simulation.time_step"),
                                            plan.time_step, shortest, automatic)) {
       plan.warnings.push_back(std::move(*warning));
@@ -306,8 +301,7 @@ MillPlan plan_mill(const MillConfig& config) {
         "{}: these materials and balls give no usable time step (shortest contact {:.3g} s, "
         "stability limit {:.3g} s); allowed: stiffnesses (materials.*.normal_stiffness, "
         "tangential_stiffness), a density and ball sizes whose contacts last a finite time",
-        config.source, std::min(plan.contact_duration_ball_ball, plan.contact_duration_ball_wall),
-        plan.critical_time_step));
+        config.source, shortest, plan.critical_time_step));
   }
   plan.spin_up_time = 0.25 * plan.revolution_period;
   plan.total_time =

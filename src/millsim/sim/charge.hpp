@@ -2,6 +2,7 @@
 // and the charge placed in the mill.
 #pragma once
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,6 +20,13 @@ inline constexpr double steps_per_contact = 20.0;
 /// A time step given in the config with fewer steps than this per shortest contact is stable
 /// but coarse (MODEL.md §4: "at least ~10–20"): the run is made, with a warning.
 inline constexpr double fewest_steps_per_contact = 10.0;
+
+/// The step "auto" takes, for mills and scenes alike: 1/steps_per_contact of the shortest
+/// contact, and never above a quarter of the stability limit (with a tangential stiffness far
+/// above the normal one, or heavy damping, the limit is the shorter).
+inline double automatic_time_step(double shortest_contact, double critical_time_step) {
+  return std::min(shortest_contact / steps_per_contact, 0.25 * critical_time_step);
+}
 
 /// The warning for a time step given in a config (at `where`, its file and line) that takes
 /// fewer than fewest_steps_per_contact steps over the `shortest` contact duration, naming

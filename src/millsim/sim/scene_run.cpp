@@ -166,16 +166,14 @@ ScenePlan plan_scene(const SceneConfig& config) {
     }
     plan.time_step = *config.time_step;
     // (Particles that can touch nothing have an infinite shortest contact: no warning.)
-    if (auto warning = coarse_step_warning(
-            config.location_of("simulation.time_step"), plan.time_step, shortest,
-            std::min(shortest / steps_per_contact, 0.25 * critical))) {
+    if (auto warning =
+            coarse_step_warning(config.location_of("simulation.time_step"), plan.time_step,
+                                shortest, automatic_time_step(shortest, critical))) {
       plan.warnings.push_back(std::move(*warning));
     }
   } else {
-    // As for mills: 1/20 of the shortest contact, at most a quarter of the stability limit.
-    plan.time_step = std::isfinite(shortest)
-                         ? std::min(shortest / steps_per_contact, 0.25 * critical)
-                         : config.duration / steps_without_contacts;
+    plan.time_step = std::isfinite(shortest) ? automatic_time_step(shortest, critical)
+                                             : config.duration / steps_without_contacts;
   }
   if (!(std::isfinite(plan.time_step) && plan.time_step > 0.0)) {
     throw InputError(fmt::format(
