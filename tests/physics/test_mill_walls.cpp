@@ -434,6 +434,34 @@ TEST(MillWall, ADiscDroppedInAStillShellFirstStrikesItWhereItFalls) {
   }
 }
 
+TEST(MillWall, AShellCollisionCutShortByAJumpIsRecordedInTheSpectrumAndTheImpactsAlike) {
+  // A disc resting on the bottom of the shell holds a shell contact. Moved to the axis between
+  // two steps, it is no longer a wall candidate at the next neighbour-list rebuild, and the
+  // collision its slot held ends there: spectrum.csv and impacts.csv must both count it, with
+  // the same energy, as they count every other collision.
+  World<2> world = smooth_shell(0.0, Vec2{{0.0, -standard_gravity}});
+  world.particles().add(Vec2{{0.0, -(shell_radius - ball_radius) - 1e-6}}, ball_radius, ball_mass);
+  ImpactSpectrum spectrum;
+  ShellImpacts impacts(true);
+  world.record_collisions_in(&spectrum);
+  world.record_impacts_in(&impacts);
+  for (int n = 0; n < 50; ++n) world.step();
+  ASSERT_EQ(world.touching_contacts(), 1u);
+  ASSERT_EQ(spectrum.total_count(ContactType::ball_shell), 0);
+  world.particles().position[0] = Vec2{};
+  world.particles().velocity[0] = Vec2{};
+  world.step();
+  EXPECT_EQ(world.touching_contacts(), 0u);
+  EXPECT_EQ(spectrum.total_count(ContactType::ball_shell), 1);
+  EXPECT_EQ(impacts.total_count(ContactType::ball_shell), 1);
+  EXPECT_GT(spectrum.total_energy(ContactType::ball_shell), 0.0);
+  double impact_energy = 0.0;
+  for (int bin = 0; bin < ShellImpacts::bins; ++bin) {
+    impact_energy += impacts.energy(ContactType::ball_shell, bin);
+  }
+  EXPECT_EQ(impact_energy, spectrum.total_energy(ContactType::ball_shell));
+}
+
 TEST(MillWall, ADiscDroppedOnALifterIsABallLifterCollisionAndBesideItABallShellOne) {
   // The lab mill's lifters, still, lifter 0 pointing straight down (its inner face at
   // y = −0.41 m). A disc let go above it at x = 0 lands on that face; one let go at x = 0.2 m

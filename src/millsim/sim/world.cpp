@@ -201,14 +201,19 @@ void World<D>::refresh_neighbours(bool moved) {
     }
   }
   candidate_share_.resize(team_size + 1);
-  // The collisions of the particles that left, in particle order.
-  for (std::size_t t = 0; t < team_size && spectrum_ != nullptr; ++t) {
+  // The collisions of the particles that left, in particle order: recorded as every other
+  // collision is (record_ended), in the spectrum and where they began.
+  for (std::size_t t = 0; t < team_size && (spectrum_ != nullptr || impacts_ != nullptr); ++t) {
     for (const std::uint32_t held : leaving_slots_[t]) {
       const std::size_t from = static_cast<std::size_t>(held) * slots;
       for (std::size_t slot = 0; slot < slots; ++slot) {
         if (wall_slot_id_[from + slot] < 0) continue;
-        spectrum_->record(wall_contact_type(walls_.kind_of(wall_slot_id_[from + slot])),
-                          wall_slot_history_[slot * old_candidates + held].dissipated);
+        const WallHistory& history = wall_slot_history_[slot * old_candidates + held];
+        const ContactType type = wall_contact_type(walls_.kind_of(wall_slot_id_[from + slot]));
+        if (spectrum_ != nullptr) spectrum_->record(type, history.dissipated);
+        if (impacts_ != nullptr) {
+          impacts_->record(type, static_cast<float>(history.start_angle), history.dissipated);
+        }
       }
     }
   }
