@@ -819,6 +819,36 @@ TEST_F(Cli, RefusesAnOmpNumThreadsTheRuntimeCannotReadOrThatExceeds1024) {
   EXPECT_EQ(millsim("info mill.toml").status, 0);
 }
 
+TEST_F(Cli, SetTakesOneKeyValueSoTheConfigMayFollowIt) {
+  // "Usage: millsim run [OPTIONS] [config]": a --set before the config took the config's path
+  // as a second override ("--set mill.toml: no '='").
+  write_config(base_config);
+  const Outcome info = millsim("info --set mill.speed=0.6 mill.toml");
+  EXPECT_EQ(info.status, 0) << info.err;
+  EXPECT_NE(info.out.find("mill.toml"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("= 60.0% of critical"), std::string::npos) << info.out;
+  const Outcome run = millsim(std::string("run -q ") + tiny_run + " mill.toml -o out");
+  EXPECT_EQ(run.status, 0) << run.err;
+  EXPECT_TRUE(fs::exists(work_ / "out" / "summary.json"));
+  const Outcome sweep =
+      millsim(std::string("sweep -q ") + tiny_run + " mill.toml --vary mill.speed=0.5 -o swept");
+  EXPECT_EQ(sweep.status, 0) << sweep.err;
+  EXPECT_TRUE(fs::exists(work_ / "swept" / "sweep.csv"));
+}
+
+TEST_F(Cli, MoreThreadsThanCoresAreWarnedOf) {
+  // The run is too small to share out, so 1024 threads cost nothing here; on a bed large
+  // enough they would wait for each other at every step.
+  write_config(base_config);
+  const Outcome many = millsim(std::string("run mill.toml -q -o many -j 1024 ") + tiny_run);
+  EXPECT_EQ(many.status, 0) << many.err;
+  EXPECT_NE(many.err.find("millsim: warning: 1024 threads on "), std::string::npos) << many.err;
+  EXPECT_NE(many.err.find("(the results are the same)"), std::string::npos) << many.err;
+  const Outcome one = millsim(std::string("run mill.toml -q -o one -j 1 ") + tiny_run);
+  EXPECT_EQ(one.status, 0) << one.err;
+  EXPECT_EQ(one.err.find(" threads on "), std::string::npos) << one.err;
+}
+
 TEST_F(Cli, AnOptionTheCommandDoesNotTakePointsToThatCommandsHelp) {
   const Outcome o = millsim("sweep --bogus --vary mill.speed=0.5,0.6");
   EXPECT_EQ(o.status, 2) << o.err;
