@@ -332,9 +332,11 @@ TEST(MillWall, EveryLifterADiscTouchesIsFoundUpToTheWidestParticleForTheLifters)
     double height, width, widest;
   };
   std::mt19937_64 random(7);
-  for (const Case c : {Case{4, 0.3, 0.05, 0.4}, Case{6, 0.3, 0.1, 0.39999998999999},
-                       Case{30, 0.15, 0.04, 0.1782696}, Case{60, 0.1, 0.02, 0.1053937},
-                       Case{200, 0.02, 0.01, 0.0352332}}) {
+  // Five lifters 0.28 m wide: the ray 3π/5 off lifter k + 2 runs past its inner corner at
+  // 0.2335 m, but from the axis it is 0.2 m, R − h, from the lifter's inner face.
+  for (const Case c : {Case{4, 0.3, 0.05, 0.4}, Case{5, 0.3, 0.28, 0.4},
+                       Case{6, 0.3, 0.1, 0.39999998999999}, Case{30, 0.15, 0.04, 0.1782696},
+                       Case{60, 0.1, 0.02, 0.1053937}, Case{200, 0.02, 0.01, 0.0352332}}) {
     Mill2D mill;
     mill.radius = 0.5;
     mill.lifter_count = c.count;

@@ -254,7 +254,9 @@ double widest_particle_for_lifters(double radius, int count, double height, doub
   // (for_each_nearby_lifter): the ray is taken that much nearer.
   constexpr double angle_error = 1e-7;
   const double off_corner = 3.0 * pi / count - angle_error - corner_angle;
-  const double half = off_corner <= 0.5 * pi ? corner_radius * std::sin(off_corner) : inner;
+  // The ray starts at the axis, R − h from the lifter's inner face: never further than that.
+  const double half =
+      off_corner <= 0.5 * pi ? std::min(inner, corner_radius * std::sin(off_corner)) : inner;
   return 2.0 * half;
 }
 

@@ -98,9 +98,10 @@ NearbyLifters nearby_lifters(const Mill2D& mill, const Vec2& planar_centre, doub
 /// has its centre within π/n of k's middle, so at least 3π/n from lifter k + 2's (and k − 2's);
 /// the distance from such a centre to that lifter is least on the ray 3π/n off its middle
 /// (it grows with the angle), where it is ρ sin(3π/n − β) to the lifter's inner corner,
-/// ρ = hypot(R − h, w/2) from the axis at β = atan(w/2 / (R − h)) off its middle, or, once the
-/// ray turns away from that corner (3π/n − β > π/2), R − h, from the axis. Twice that is the
-/// widest particle. plan_mill refuses a mill whose largest ball is wider. In mill_geometry.cpp.
+/// ρ = hypot(R − h, w/2) from the axis at β = atan(w/2 / (R − h)) off its middle, or R − h,
+/// from the axis (the ray starts there), whichever is less; once the ray turns away from that
+/// corner (3π/n − β > π/2), R − h. (With five wide lifters, R − h is the less.) Twice that is
+/// the widest particle. plan_mill refuses a mill whose largest ball is wider. In mill_geometry.cpp.
 double widest_particle_for_lifters(double radius, int count, double height, double width);
 
 /// An infinite plane (a line in 2D): the particle side is where (x − point)·normal > 0.
