@@ -142,13 +142,45 @@ bool beyond_lifter_reach(const Mill2D& mill, const Vec2& planar_centre, double p
 }
 
 /// With conical ends the shell is the cylinder 0 ≤ z ≤ length only. A centre beyond an end of
-/// it that touches the shell's surface is inside the cone (closest to the cone's face, never to
-/// the shell's edge: the shell–cone corner is concave) unless it has been pushed out through
-/// the corner, beyond the cone's extent; the shell then sends it back.
+/// it is in front of the cone (shell_rim_contact) unless it has been pushed out through the
+/// corner, beyond the cone's extent (past the line through the rim along the cone's normal);
+/// the shell then sends it back.
 bool on_shell_side(const Mill3D& mill, const Vec2& planar_centre, double z) {
   if (!mill.has_cones() || (z >= 0.0 && z <= mill.length)) return true;
   const double beyond = z < 0.0 ? -z : z - mill.length;
   return norm(planar_centre) - mill.radius > beyond * std::tan(mill.cone_angle);
+}
+
+/// The shell's contact with a centre in front of a cone (beyond an end of the cylinder, not
+/// on_shell_side): the shell's closest point is then its rim, where the cone begins. The shell–
+/// cone corner is concave, so a sphere pressed into the cone near it can reach over the rim
+/// into the shell; the contact begins with no overlap as the rim comes within r, and as the
+/// centre crosses the rim's plane into the cylinder it becomes the shell's contact with no
+/// jump. A centre pushed out through the cone's face (behind it) gets none: the cone sends it
+/// back.
+bool shell_rim_contact(const Mill3D& mill, const Vec2& planar_centre, double z,
+                       double particle_radius, WallContact<3>& contact) {
+  const double rho = norm(planar_centre);
+  const double beyond = z < 0.0 ? -z : z - mill.length;  // > 0: not on_shell_side
+  const double in_front_of_cone =
+      (mill.radius - rho) * std::sin(mill.cone_angle) - beyond * std::cos(mill.cone_angle);
+  if (in_front_of_cone < 0.0 || rho <= 0.0) return false;
+  const double rim_z = z < 0.0 ? 0.0 : mill.length;
+  const double radial = rho - mill.radius;  // ≤ 0 in front of the cone
+  const double axial = z - rim_z;
+  const double distance = std::hypot(radial, axial);
+  if (distance >= particle_radius || distance <= 0.0) return false;
+  const Vec2 outward = planar_centre * (1.0 / rho);
+  contact.wall_id = 0;
+  contact.kind = WallKind::shell;
+  contact.normal =
+      Vec3{{radial / distance * outward[0], radial / distance * outward[1], axial / distance}};
+  contact.overlap = particle_radius - distance;
+  const Vec2 point = mill.radius * outward;
+  contact.point = Vec3{{point[0], point[1], rim_z}};
+  const Vec2 velocity = cross(mill.angular_speed, point);
+  contact.wall_velocity = Vec3{{velocity[0], velocity[1], 0.0}};
+  return true;
 }
 
 /// A 3D contact from the in-plane one found on the cross-section, at height z, written into
@@ -186,10 +218,11 @@ WallContact<3> end_wall_contact(const Mill3D& mill, int wall_id, const Vec2& out
 /// length): the cone and the trunnion plate that closes it. Works in the meridian plane of the
 /// centre, in coordinates (ρ, s): ρ the distance from the axis, s the distance beyond the end
 /// of the cylinder. The cone runs from (R, 0) to (r_t, c) along d = (−cos α, sin α), its
-/// inward normal is (−sin α, −cos α); the plate is s = c for ρ ≤ r_t. The mill's inside is
-/// convex, so a centre inside it is closest to the face of the cone or of the plate whose
-/// extent it lies across, never to the corner between them; only a centre pushed out beyond
-/// that corner (by a violent step) is sent back towards the corner itself.
+/// inward normal is (−sin α, −cos α); the plate is s = c for ρ ≤ r_t. Each face's contact is
+/// with its closest point to the centre: the foot on the face where the foot lies across it,
+/// else its rim (the shell–cone or the cone–plate corner) for a centre inside the mill. Only a
+/// centre pushed out beyond the cone–plate corner (by a violent step) is sent back towards the
+/// corner itself, by the plate.
 int cone_contacts(const Mill3D& mill, int side, const Vec3& centre, double particle_radius,
                   WallContact<3>* out) {
   const double rho = std::sqrt(centre[0] * centre[0] + centre[1] * centre[1]);
@@ -210,15 +243,39 @@ int cone_contacts(const Mill3D& mill, int side, const Vec3& centre, double parti
   // Along the cone from the shell, and the signed distance from it (positive inside).
   const double along = -(rho - mill.radius) * cos_a + s * sin_a;
   const double inside_cone = -(rho - mill.radius) * sin_a - s * cos_a;
-  if (along >= 0.0 && along <= slant && inside_cone < particle_radius) {
-    out[count++] = end_wall_contact(mill, cone_id, outward, mill.radius - along * cos_a,
-                                    end_z + axial_sign * along * sin_a, -sin_a, -axial_sign * cos_a,
-                                    particle_radius - inside_cone);
-  }
   const double inside_plate = c - s;
-  if (rho <= r_t && inside_plate < particle_radius) {
-    out[count++] = end_wall_contact(mill, plate_id, outward, rho, end_z + axial_sign * c, 0.0,
-                                    -axial_sign, particle_radius - inside_plate);
+  // A face's rim (radial, beyond) as the closest point of a centre in front of the face's
+  // neighbour whose foot on the face's line falls past the rim: its contact, if within reach.
+  // The corners of the profile are concave, so a sphere pressed into one face near a corner can
+  // reach over the rim of the next; the contact begins with no overlap, and it becomes the
+  // face's own contact with no jump as the foot crosses onto the face.
+  const auto rim_contact = [&](int wall_id, double radial, double beyond) {
+    const double to_radial = rho - radial;
+    const double to_beyond = s - beyond;
+    const double distance = std::hypot(to_radial, to_beyond);
+    if (distance >= particle_radius || distance <= 0.0) return;
+    out[count++] = end_wall_contact(mill, wall_id, outward, radial, end_z + axial_sign * beyond,
+                                    to_radial / distance, axial_sign * to_beyond / distance,
+                                    particle_radius - distance);
+  };
+  if (along >= 0.0 && along <= slant) {
+    if (inside_cone < particle_radius) {
+      out[count++] = end_wall_contact(mill, cone_id, outward, mill.radius - along * cos_a,
+                                      end_z + axial_sign * along * sin_a, -sin_a,
+                                      -axial_sign * cos_a, particle_radius - inside_cone);
+    }
+  } else if (along < 0.0 && rho <= mill.radius) {
+    rim_contact(cone_id, mill.radius, 0.0);  // in the cylinder, near the shell's rim
+  } else if (along > slant && rho <= r_t && inside_plate >= 0.0) {
+    rim_contact(cone_id, r_t, c);  // in front of the plate, near its rim
+  }
+  if (rho <= r_t) {
+    if (inside_plate < particle_radius) {
+      out[count++] = end_wall_contact(mill, plate_id, outward, rho, end_z + axial_sign * c, 0.0,
+                                      -axial_sign, particle_radius - inside_plate);
+    }
+  } else if (along <= slant && inside_cone >= 0.0 && inside_plate >= 0.0) {
+    rim_contact(plate_id, r_t, c);  // in front of the cone, near the plate's rim
   }
   if (along > slant && rho > r_t) {
     // Beyond the corner between cone and plate: outside the mill (see above).
@@ -312,8 +369,12 @@ int mill_contacts(const Mill3D& mill, const Vec3& centre, double particle_radius
   const Vec2 planar{{centre[0], centre[1]}};
   const double z = centre[2];
   WallContact<2> found;
-  if (shell_contact(mill, planar, particle_radius, found) && on_shell_side(mill, planar, z)) {
-    extrude(found, z, out[count++]);
+  if (shell_contact(mill, planar, particle_radius, found)) {
+    if (on_shell_side(mill, planar, z)) {
+      extrude(found, z, out[count++]);
+    } else if (shell_rim_contact(mill, planar, z, particle_radius, out[count])) {
+      ++count;
+    }
   }
   if ((nearby == nullptr || nearby->count != 0) &&
       !beyond_lifter_reach(mill, planar, particle_radius)) {

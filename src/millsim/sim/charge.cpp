@@ -198,8 +198,23 @@ MillPlan plan_mill(const MillConfig& config) {
   if (config.cone_length > 0.0) {
     const double r = plan.radius;
     const double c = config.cone_length;
-    plan.trunnion_radius = r - c / std::tan(config.cone_angle_degrees * pi / 180.0);
+    const double tan_cone = std::tan(config.cone_angle_degrees * pi / 180.0);
+    plan.trunnion_radius = r - c / tan_cone;
     const double r_t = plan.trunnion_radius;
+    if (r_t < 0.5 * plan.largest_ball) {
+      // The contact with a cone is found in the meridian plane of the centre, on its side of
+      // the axis: a ball that could reach across the trunnion plate to the cone beyond the axis
+      // would be pushed by one side only.
+      throw InputError(fmt::format(
+          "{}: mill.cone_length: {} m leaves a trunnion radius of {} m, less than the "
+          "largest ball's radius, {} m; allowed: at most {} m with cones of {} degrees in a "
+          "mill of {} m diameter (the trunnion at least the largest ball's radius), or smaller "
+          "balls",
+          config.location_of("mill.cone_length"), c, limit_text(r_t, Allowed::below),
+          0.5 * plan.largest_ball,
+          limit_text((r - 0.5 * plan.largest_ball) * tan_cone, Allowed::below),
+          config.cone_angle_degrees, config.diameter));
+    }
     plan.cone_volume = pi * c * (r * r + r * r_t + r_t * r_t) / 3.0;
     plan.cone_bed_volume = cone_bed_volume(r, r_t, c, config.filling);
     bed_volume += 2.0 * plan.cone_bed_volume;
