@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <random>
 #include <utility>
@@ -154,6 +155,32 @@ void check_equal_radii(const std::vector<double>& sizes, double period) {
       renumbered.radius.push_back(cloud.radius[before]);
     }
     EXPECT_EQ(listed_pairs(list), brute_force_pairs_periodic(renumbered, skin, period));
+  }
+}
+
+TEST(NeighbourList, ParticlesFarApartOrDivergedSizeTheGridWithinBounds) {
+  // The grid's cells are doubled in size until there are at most 32 a particle. Counted in
+  // integers, the cells of particles far apart wrapped round: two 0.1 mm discs 4.4e5 m apart
+  // on each axis asked for 2^32 × 2^32 cells, counted as 0, and the rebuild wrote far outside
+  // the grid (a scene allows ±1e6 m). Nor may a diverged particle (NaN or infinite) make the
+  // grid unbounded or its cell index undefined. Each case lists the one pair that is near.
+  const double far = 440234.14778875007;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<double> radius(4, 5e-5);
+  for (const double odd : {far, -far, nan, inf, -inf}) {
+    SCOPED_TRACE(odd);
+    NeighbourList<2> discs(5e-6);
+    discs.rebuild({Vec2{{odd, odd}}, Vec2{{0.0, 0.0}}, Vec2{{0.0, 9e-5}}, Vec2{{far, 0.0}}},
+                  radius);
+    EXPECT_EQ(listed_pairs(discs), (PairList{{1, 2}}));
+    NeighbourList<3> spheres(5e-6);
+    const double wide = 429.91610875;  // 2^22 cells on each axis, 2^66 in all
+    const double x = std::isfinite(odd) ? wide : odd;
+    spheres.rebuild(
+        {Vec3{{x, x, x}}, Vec3{{0.0, 0.0, 0.0}}, Vec3{{0.0, 9e-5, 0.0}}, Vec3{{wide, 0.0, 0.0}}},
+        radius);
+    EXPECT_EQ(listed_pairs(spheres), (PairList{{1, 2}}));
   }
 }
 

@@ -204,18 +204,28 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
     // largest one is.
     const auto [smallest, largest] = std::minmax_element(radius.begin(), radius.end());
     // The particles' bounds, on each thread over its share (minima and maxima are exact, so
-    // the bounds are the same however the particles are shared).
-    Vec<D> low = position[0];
-    Vec<D> high = position[0];
+    // the bounds are the same however the particles are shared). Only finite coordinates
+    // count: a diverged particle (NaN or infinite) lands in an edge cell, and cannot make the
+    // grid unbounded.
+    constexpr double none_low = std::numeric_limits<double>::max();
+    constexpr double none_high = std::numeric_limits<double>::lowest();
+    Vec<D> low;
+    Vec<D> high;
+    for (int a = 0; a < D; ++a) {
+      low[a] = none_low;
+      high[a] = none_high;
+    }
 #pragma omp parallel if (parallel)
     {
-      Vec<D> own_low = position[0];
-      Vec<D> own_high = position[0];
+      Vec<D> own_low = low;
+      Vec<D> own_high = high;
 #pragma omp for schedule(static) nowait
       for (std::size_t i = 0; i < count; ++i) {
         for (int a = 0; a < D; ++a) {
-          own_low[a] = std::min(own_low[a], position[i][a]);
-          own_high[a] = std::max(own_high[a], position[i][a]);
+          const double x = position[i][a];
+          if (!std::isfinite(x)) continue;
+          own_low[a] = std::min(own_low[a], x);
+          own_high[a] = std::max(own_high[a], x);
         }
       }
 #pragma omp critical(neighbour_list_bounds)
@@ -224,39 +234,50 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
         high[a] = std::max(high[a], own_high[a]);
       }
     }
+    for (int a = 0; a < D; ++a) {
+      if (low[a] > high[a]) low[a] = high[a] = 0.0;  // no finite coordinate on this axis
+    }
     const bool periodic = period_ > 0.0;
     if (periodic) {
       low[D - 1] = 0.0;
       high[D - 1] = period_;
     }
+    // Cells at least a pair's reach wide, doubled until there are at most 32 a particle (plus
+    // 4096). Counted in doubles: the extents are finite, but particles far apart (a scene
+    // allows ±1e6 m) ask for more cells than an integer holds, and a product that wrapped
+    // round to a small number once passed the test and sized the grid wrongly.
+    const double most_cells = 32.0 * static_cast<double>(count) + 4096.0;
     double cell = 2.0 * *smallest + skin_;
+    std::array<double, D> cells_wide{};
+    for (;;) {
+      double product = 1.0;
+      for (int a = 0; a < D; ++a) {
+        // Along a periodic axis the cells tile the period exactly, each at least `cell`.
+        cells_wide[a] = a == D - 1 && periodic ? std::max(1.0, std::floor(period_ / cell))
+                                               : std::floor((high[a] - low[a]) / cell) + 1.0;
+        product *= cells_wide[a];
+      }
+      if (product <= most_cells) break;
+      cell *= 2.0;
+    }
     std::array<long, D> cells{};
     std::array<double, D> side{};
     std::size_t total = 1;
-    for (;;) {
-      total = 1;
-      for (int a = 0; a < D; ++a) {
-        side[a] = cell;
-        cells[a] = static_cast<long>((high[a] - low[a]) / cell) + 1;
-        if (a == D - 1 && periodic) {
-          // Along a periodic axis the cells tile the period exactly, each at least `cell`.
-          cells[a] = std::max(1L, static_cast<long>(period_ / cell));
-          side[a] = period_ / static_cast<double>(cells[a]);
-        }
-        total *= static_cast<std::size_t>(cells[a]);
-      }
-      if (total <= 32 * count + 4096) break;
-      cell *= 2.0;
+    for (int a = 0; a < D; ++a) {
+      cells[a] = static_cast<long>(cells_wide[a]);
+      side[a] = a == D - 1 && periodic ? period_ / cells_wide[a] : cell;
+      total *= static_cast<std::size_t>(cells[a]);
     }
     // Counting sort of the particles into cells.
     particle_cell_.resize(count);
     cell_start_.assign(total + 1, 0);
     std::vector<std::array<long, D>>& home = particle_home_;
     home.resize(count);
-    // The cell along axis a of coordinate x (clamped to the grid).
+    // The cell along axis a of coordinate x (clamped to the grid, in doubles: a NaN goes to
+    // the first cell, an infinity to the first or the last).
     const auto cell_of = [&](double x, int a) {
-      const auto c = static_cast<long>(std::max(0.0, x - low[a]) / side[a]);
-      return std::min(c, cells[a] - 1);
+      const double c = std::max(0.0, x - low[a]) / side[a];
+      return c < cells_wide[a] - 1.0 ? static_cast<long>(c) : cells[a] - 1;
     };
     // The cells' order: axis 0 varies fastest; in 3D the axis with more cells of the other two
     // varies slowest. A run of particles in that order (a thread's share of the step) then
