@@ -397,6 +397,48 @@ TEST(VtkOutput, ACollectionWhoseWriteFailsIsLeftWholeWithWhatItListed) {
   std::filesystem::remove_all(directory);
 }
 
+TEST(VtkOutput, ASnapshotIndexWhoseWriteFailsKeepsWholeRowsOnly) {
+  // The same limit on index.csv (a full disk left it with half a row: "90,snapshot"). One
+  // still disc, so that each snapshot file (about 60 bytes) stays below the limit and the
+  // index's third row is the write that meets it.
+  const std::filesystem::path directory = testing::fresh_directory("snapshots");
+  const std::filesystem::path index = directory / "index.csv";
+  WorldSettings<2> settings;
+  settings.time_step = 1e-3;
+  World<2> world(settings, Walls<2>{});
+  world.particles().add(Vec2{}, 0.01, 0.002);
+  rlimit saved{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  std::string whole_after_two;
+  std::string message;
+  {
+    SnapshotWriter snapshots(directory);
+    snapshots.write(world);
+    world.step();
+    snapshots.write(world);
+    whole_after_two = read_all(index);
+    rlimit small = saved;
+    small.rlim_cur = whole_after_two.size() + 10;
+    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+    world.step();
+    try {
+      snapshots.write(world);
+    } catch (const std::runtime_error& e) {
+      message = e.what();
+    }
+    setrlimit(RLIMIT_FSIZE, &saved);
+  }
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_EQ(message, index.string() + ": write failed: " +
+                         std::make_error_code(std::errc::file_too_large).message());
+  EXPECT_TRUE(std::filesystem::exists(directory / "snapshot_000002.csv"))
+      << "the snapshot file should have fitted; the index's row was to fail";
+  EXPECT_EQ(std::count(whole_after_two.begin(), whole_after_two.end(), '\n'), 3);
+  EXPECT_EQ(read_all(index), whole_after_two);
+  std::filesystem::remove_all(directory);
+}
+
 TEST(VtkOutput, AFileWhoseWriteFailsSaysWhy) {
   const std::filesystem::path directory = testing::fresh_directory("vtk");
   rlimit saved{};

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -292,23 +293,37 @@ void SnapshotWriter::write(const World<D>& world) {
   // The index gets the snapshot's row once the snapshot is whole, so that every file it names
   // is complete; rows are appended and flushed one by one.
   const std::filesystem::path index_path = directory_ / "index.csv";
-  if (index_ == nullptr) {
+  const bool first = index_ == nullptr;
+  if (first) {
     index_ = std::fopen(index_path.c_str(), "wb");
     if (index_ == nullptr) {
       throw std::runtime_error(
           fmt::format("{}: cannot write: {}", index_path.string(), std::strerror(errno)));
     }
-    std::fputs("snapshot,file,time_s,shell_angle_rad\n", index_);
   }
-  const std::string row = fmt::format("{},{},{},{}\n", count_, name, world.time(),
-                                      world.walls().mill ? world.walls().mill->angle : 0.0);
+  const std::string row =
+      fmt::format("{}{},{},{},{}\n", first ? "snapshot,file,time_s,shell_angle_rad\n" : "", count_,
+                  name, world.time(), world.walls().mill ? world.walls().mill->angle : 0.0);
   errno = 0;
-  if (std::fwrite(row.data(), 1, row.size(), index_) != row.size() || std::fflush(index_) != 0) {
-    const int error = errno;
-    throw std::runtime_error(fmt::format("{}: write failed: {}", index_path.string(),
-                                         error != 0 ? std::strerror(error) : "unknown error"));
+  if (std::fwrite(row.data(), 1, row.size(), index_) == row.size() && std::fflush(index_) == 0) {
+    index_end_ += static_cast<long>(row.size());
+    ++count_;
+    return;
   }
-  ++count_;
+  // Failed (a full disk, say): the index as it was, whole rows only (the file removed if it
+  // had none), as the collections are left.
+  const int error = errno;
+  std::clearerr(index_);
+  if (first) {
+    std::fclose(index_);
+    index_ = nullptr;
+    std::error_code ignored;
+    std::filesystem::remove(index_path, ignored);
+  } else if (::ftruncate(::fileno(index_), index_end_) == 0) {
+    std::fseek(index_, index_end_, SEEK_SET);
+  }
+  throw std::runtime_error(fmt::format("{}: write failed: {}", index_path.string(),
+                                       error != 0 ? std::strerror(error) : "unknown error"));
 }
 
 template void SnapshotWriter::write(const World<2>&);

@@ -38,6 +38,7 @@ class SnapshotWriter {
   bool vtk_ = false;
   int count_ = 0;
   std::FILE* index_ = nullptr;  // index.csv, open from the first snapshot on
+  long index_end_ = 0;          // its size after its last whole row
   // particles.pvd and mill.pvd, from the first snapshot on, if vtk_
   std::unique_ptr<PvdCollection> particle_collection_;
   std::unique_ptr<PvdCollection> mill_collection_;
