@@ -143,6 +143,12 @@ void warn(const std::vector<std::string>& warnings, std::string_view context = {
 constexpr std::initializer_list<const char*> mill_result_names = {
     "summary.json", "power.csv",          "power_timeseries.csv",
     "spectrum.csv", "charge_profile.csv", "impacts.csv"};
+/// What `run` clears, of a mill or a scene: the results of both kinds, so that a scene run
+/// where a mill ran (or the other way round) leaves none of the other's beside its own
+/// summary.json.
+constexpr std::initializer_list<const char*> run_result_names = {
+    "summary.json",       "power.csv",   "power_timeseries.csv", "spectrum.csv",
+    "charge_profile.csv", "impacts.csv", "trajectory.csv",       "final.csv"};
 
 /// Plans, places the charge, and only then creates the output directory, calls `started`,
 /// gives the plan's warnings and runs, so that a config that cannot run writes nothing and
@@ -155,7 +161,7 @@ MillResult run_job(const MillPlan& plan, const std::string& out_location, bool s
   millsim::World<D> world = millsim::build_mill_world<D>(plan);
   const std::filesystem::path out = config.output_directory;
   const std::vector<std::string> cleared = prepare_output_directory(
-      out, out_location, mill_result_names,
+      out, out_location, run_result_names,
       config.snapshot_interval > 0.0 ? Snapshots::made : Snapshots::removed);
   if (started) started();
   warn(cleared, context);
@@ -182,7 +188,7 @@ int run_scene_command(const millsim::SceneConfig& scene, const JobOptions& optio
   const millsim::ScenePlan plan = millsim::plan_scene(scene);
   const std::filesystem::path out = scene.output_directory;
   const std::vector<std::string> cleared = prepare_output_directory(
-      out, output_location(scene, options), {"summary.json", "trajectory.csv", "final.csv"});
+      out, output_location(scene, options), run_result_names, Snapshots::removed);
   if (!options.quiet) fmt::print("millsim: running scene {}\n", scene.source);
   warn(cleared);
   warn(plan.warnings);

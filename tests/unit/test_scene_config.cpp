@@ -406,6 +406,33 @@ TEST(SceneRun, WritesTrajectoryFinalAndSummaryAndNothingPartial) {
   fs::remove_all(work, ignored);
 }
 
+TEST(SceneRun, ASceneRunWhereAMillRanLeavesNoneOfTheMillsResultsAndTheOtherWayRound) {
+  // Each kind once cleared only its own results: a scene run into a mill run's directory left
+  // power.csv and the rest (and snapshots/) beside the scene's summary.json, which says the
+  // run finished, so that they looked like its results.
+  namespace fs = std::filesystem;
+  const fs::path work = millsim::testing::fresh_directory("scene");
+  ASSERT_FALSE(work.empty());
+  std::ofstream(work / "drop.toml") << drop;
+  const std::string tiny_mill =
+      "run -q --out out --set simulation.revolutions=1 --set simulation.measure_revolutions=1 "
+      "--set simulation.settle_time=0.01 --set output.snapshot_interval=0.05";
+  const std::vector<std::string> mill_files = {"power.csv",    "power_timeseries.csv",
+                                               "spectrum.csv", "charge_profile.csv",
+                                               "impacts.csv",  "snapshots"};
+  ASSERT_EQ(millsim_in(work, tiny_mill), 0);
+  for (const std::string& name : mill_files) EXPECT_TRUE(fs::exists(work / "out" / name)) << name;
+  ASSERT_EQ(millsim_in(work, "run drop.toml -q --out out"), 0);
+  for (const std::string& name : mill_files) EXPECT_FALSE(fs::exists(work / "out" / name)) << name;
+  EXPECT_TRUE(fs::exists(work / "out" / "trajectory.csv"));
+  ASSERT_EQ(millsim_in(work, tiny_mill), 0);
+  EXPECT_FALSE(fs::exists(work / "out" / "trajectory.csv"));
+  EXPECT_FALSE(fs::exists(work / "out" / "final.csv"));
+  EXPECT_TRUE(fs::exists(work / "out" / "power.csv"));
+  std::error_code ignored;
+  fs::remove_all(work, ignored);
+}
+
 TEST(SceneConfig, ATrajectoryIntervalAsLongAsTheRunOrLongerGivesOnlyStartAndEnd) {
   // 10000 steps of 1e-6 s.
   EXPECT_EQ(millsim::plan_scene(scene(drop)).trajectory_every, 10);
