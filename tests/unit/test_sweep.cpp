@@ -70,6 +70,9 @@ TEST(Sweep, AListSplitsOnlyBetweenValues) {
                     "0.5}]"}));
   EXPECT_EQ(parse_vary("reference.case=\"a,b:c\", 'd,e', \"f\\\",g\"").values,
             (Values{"\"a,b:c\"", "'d,e'", "\"f\\\",g\""}));
+  // Also where the string with the colon is not the first value (it was taken for a range).
+  EXPECT_EQ(parse_vary("reference.case=\"a\",\"b:c\", ['d:e']").values,
+            (Values{"\"a\"", "\"b:c\"", "['d:e']"}));
   // Multi-line strings hold single quotes; a bracket inside a string in an array is text.
   EXPECT_EQ(parse_vary(R"(reference.case="""a"b,c""",'''a'b,c''',["a]", 1],2)").values,
             (Values{R"("""a"b,c""")", "'''a'b,c'''", R"(["a]", 1])", "2"}));

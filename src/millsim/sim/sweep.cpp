@@ -70,6 +70,8 @@ std::optional<double> read_number(std::string_view text) {
 /// comma after it still ends the value. Strings are basic ("...", with \ escapes), literal
 /// ('...') or multi-line (""" or '''). An unclosed one runs to the end of the text: the value is
 /// then read as --set reads it (refused if its key takes a number; text if it takes text).
+/// A top-level comma starts a new value whatever the separator looked for, so that in
+/// "a","b:c" the colon is inside the second value's string.
 std::vector<std::size_t> top_level_positions(std::string_view text, char separator) {
   std::vector<std::size_t> positions;
   int depth = 0;
@@ -92,8 +94,8 @@ std::vector<std::size_t> top_level_positions(std::string_view text, char separat
       ++depth;
     } else if (depth > 0 && (c == ']' || c == '}')) {
       --depth;
-    } else if (depth == 0 && c == separator) {
-      positions.push_back(i);
+    } else if (depth == 0 && (c == separator || c == ',')) {
+      if (c == separator) positions.push_back(i);
       value_started = false;
     }
     ++i;
