@@ -570,6 +570,7 @@ void run_sweep(const std::vector<MillPlan>& plans, const std::vector<millsim::Sw
   auto last_written = Clock::now();
   Clock::duration writing{};  // how long the last rewrite took
   std::mutex report;          // the rows, the table and the lines on stderr
+  std::size_t finished = 0;   // points done so far, for those lines
   const auto run_point = [&](std::size_t i, bool show_progress) {
     millsim::SweepRow row = rows[i];
     const MillPlan& plan = plans[i];
@@ -590,6 +591,7 @@ void run_sweep(const std::vector<MillPlan>& plans, const std::vector<millsim::Sw
     {
       const std::lock_guard lock(report);
       rows[i] = std::move(row);
+      ++finished;
       // Nothing may leave a point's thread: a table or a line that cannot be written here is
       // left for the final table, written after the points, to report.
       try {
@@ -600,7 +602,8 @@ void run_sweep(const std::vector<MillPlan>& plans, const std::vector<millsim::Sw
           writing = last_written - now;
         }
         if (!quiet) {
-          fmt::print(stderr, "point {} of {} done ({}): {}\n", i, rows.size(),
+          // "point" is sweep.csv's, from 0; the count of those done, from 1.
+          fmt::print(stderr, "point {} done, {} of {} ({}): {}\n", i, finished, rows.size(),
                      fmt::join(millsim::point_overrides(axes, rows[i].values), ", "),
                      rows[i].status);
         }
@@ -1051,7 +1054,18 @@ int main(int argc, char** argv) {
   // Anything run_program lets through (an exception from setting up the command line, or from
   // printing an error) is still a message and exit status 1, not std::terminate's abort.
   try {
-    return run_program(argc, argv);
+    const int status = run_program(argc, argv);
+    // What was printed and not yet written (a summary line, a table, `info`'s figures) must
+    // reach standard output: a full disk or a closed stream is a failure, not a success with
+    // nothing to show for it.
+    errno = 0;
+    if (std::fflush(stdout) != 0 || std::ferror(stdout) != 0) {
+      const int error = errno;
+      std::fprintf(stderr, "millsim: failed: cannot write to standard output: %s\n",
+                   error != 0 ? std::strerror(error) : "write error");
+      return status == 0 ? 1 : status;
+    }
+    return status;
   } catch (const std::exception& error) {
     std::fprintf(stderr, "millsim: failed: %s\n", error.what());
   } catch (...) {

@@ -124,6 +124,9 @@ TEST_F(SweepPowerCurve, ResultsDoNotDependOnTheThreadsAndEveryPointHasItsDirecto
   ASSERT_EQ(parallel.status, 0) << parallel.err;
   ASSERT_EQ(nested.status, 0) << nested.err;
   EXPECT_NE(nested.out.find("(4 at a time, 2 threads each)"), std::string::npos) << nested.out;
+  // A line per point as it ends: its number in sweep.csv, and how many are done (it once read
+  // "point 3 of 4 done" for the last).
+  EXPECT_NE(nested.err.find(" done, 4 of 4 ("), std::string::npos) << nested.err;
   const auto one = read_csv(work_ / "one" / "sweep.csv");
   ASSERT_EQ(one.size(), 4u);
   for (const char* other : {"two", "eight"}) {

@@ -836,6 +836,22 @@ TEST_F(Cli, SetTakesOneKeyValueSoTheConfigMayFollowIt) {
   EXPECT_TRUE(fs::exists(work_ / "swept" / "sweep.csv"));
 }
 
+TEST_F(Cli, OutputThatCannotBeWrittenIsAFailure) {
+  // `millsim info mill.toml > info.txt` on a full disk once gave an empty file and exit 0.
+  write_config(base_config);
+  for (const std::string& args :
+       {std::string("info mill.toml"), std::string("run mill.toml -q -o out ") + tiny_run}) {
+    const std::string command = "cd " + quoted(work_.string()) + " && " + quoted(MILLSIM_BINARY) +
+                                " " + args + " >/dev/full 2>" + quoted((root_ / "err").string());
+    const int raw = std::system(command.c_str());
+    ASSERT_TRUE(raw != -1 && WIFEXITED(raw)) << args;
+    EXPECT_EQ(WEXITSTATUS(raw), 1) << args;
+    EXPECT_NE(read_all(root_ / "err").find("millsim: failed: cannot write to standard output: "),
+              std::string::npos)
+        << args << ": " << read_all(root_ / "err");
+  }
+}
+
 TEST_F(Cli, MoreThreadsThanCoresAreWarnedOf) {
   // The run is too small to share out, so 1024 threads cost nothing here; on a bed large
   // enough they would wait for each other at every step.
