@@ -511,9 +511,18 @@ int validate_command(const std::string& directory, const JobOptions& options) {
     const std::string paper_error =
         r.paper ? fmt::format("{:+.1f}", 100.0 * (*r.paper - r.measured) / r.measured)
                 : std::string("n/a");
-    fmt::print("{:<8} {:>12.4g} {:>12} {:>12.4g} {:>+9.1f} {:>10}  {} (±{:.0f}%)\n", r.name,
-               r.measured, paper, r.predicted, 100.0 * error, paper_error, ok ? "yes" : "NO",
-               100.0 * r.tolerance);
+    // One decimal, or more where one would read as within the tolerance (−15.04 % as
+    // "-15.0" beside "NO (±15%)").
+    std::string percent = fmt::format("{:+.1f}", 100.0 * error);
+    for (int decimals = 2; !ok && decimals < 12; ++decimals) {
+      double read = 0.0;
+      std::from_chars(percent.data() + (percent[0] == '+' ? 1 : 0), percent.data() + percent.size(),
+                      read);
+      if (std::abs(read) > 100.0 * r.tolerance) break;
+      percent = fmt::format("{:+.{}f}", 100.0 * error, decimals);
+    }
+    fmt::print("{:<8} {:>12.4g} {:>12} {:>12.4g} {:>9} {:>10}  {} (±{:.3g}%)\n", r.name, r.measured,
+               paper, r.predicted, percent, paper_error, ok ? "yes" : "NO", 100.0 * r.tolerance);
   }
   millsim::write_whole_file(table_path, table);
   if (!options.quiet) fmt::print(stderr, "table in {}\n", table_path.string());

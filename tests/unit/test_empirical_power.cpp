@@ -193,6 +193,21 @@ TEST(EmpiricalPower, ResultWarningsFlagAnOpenEnergyBalanceOrPowersThatDisagree) 
   result.energy_balance_error = 21.2;
   EXPECT_NE(result_warnings(result)[0].find("off by 2120 % of"), std::string::npos)
       << result_warnings(result)[0];
+  // Just past 5 %: not "off by 5 % ... (more than 5 %)".
+  result.energy_balance_error = 0.05004;
+  EXPECT_NE(result_warnings(result)[0].find("off by 5.004 % of"), std::string::npos)
+      << result_warnings(result)[0];
+  // The same for overlaps just past a half of the radius.
+  result.energy_balance_error = 0.01;
+  result.power_dissipation_kw = result.power_kw;
+  result.largest_overlap_fraction = 0.504;
+  ASSERT_EQ(result_warnings(result).size(), 1u);
+  EXPECT_NE(result_warnings(result)[0].find("overlapped by up to 50.4 % of the smaller ball's "
+                                            "radius (more than 50 %)"),
+            std::string::npos)
+      << result_warnings(result)[0];
+  result.largest_overlap_fraction = 0.0;
+  result.power_dissipation_kw = 0.89;
   // A balance that is not a number is not closed either: it is the warning given, not the
   // powers' (which still differ by 11 % here, so a NaN taken as closed would give that one).
   result.energy_balance_error = std::nan("");

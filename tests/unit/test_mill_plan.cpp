@@ -215,6 +215,21 @@ TEST(MillPlan, AGivenTimeStepOfFewerThanTenStepsPerContactIsRunWithAWarning) {
         "\"auto\" takes 0.00013 s, 1/20 of it"}) {
     EXPECT_NE(warning.find(part), std::string::npos) << warning;
   }
+  // Just coarser than 10 steps: 9.9987 steps, which three digits once showed as "10 steps,
+  // fewer than 10".
+  const MillPlan just = plan_mill(lab_mill({"simulation.time_step=2.60418e-4"}));
+  ASSERT_EQ(just.warnings.size(), 1u);
+  EXPECT_NE(just.warnings[0].find("in 9.999 steps, fewer than 10"), std::string::npos)
+      << just.warnings[0];
+}
+
+TEST(MillPlan, AFigureBeyondAThresholdIsShownBeyondIt) {
+  EXPECT_EQ(beyond_text(5.2, 5.0), "5.2");
+  EXPECT_EQ(beyond_text(5.004, 5.0), "5.004");
+  EXPECT_EQ(beyond_text(4.9996, 5.0), "4.9996");
+  EXPECT_EQ(beyond_text(50.4, 50.0, 2), "50.4");
+  EXPECT_EQ(beyond_text(63.0, 50.0, 2), "63");
+  EXPECT_EQ(beyond_text(5.0, 5.0), "5");  // on the threshold: as asked
 }
 
 TEST(MillPlan, SnapshotsAreCountedAndTheirSizeBoundedWithAWarningWhenLarge) {

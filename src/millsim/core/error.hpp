@@ -33,6 +33,22 @@ inline std::string limit_text(double limit, Allowed allowed) {
   return fmt::format("{}", limit);  // the shortest form that reads back as the limit itself
 }
 
+/// A value a warning reports as beyond a threshold ("X, more than T"), in `digits` significant
+/// digits, or in more where fewer would read as the threshold itself or as on its other side:
+/// 9.9987 steps against "fewer than 10" is "9.999", not "10"; 5.004 % against "more than 5 %"
+/// is "5.004", not "5".
+inline std::string beyond_text(double value, double threshold, int digits = 3) {
+  for (int shown = digits; shown < 17; ++shown) {
+    std::string text = fmt::format("{:.{}g}", value, shown);
+    double read = 0.0;
+    std::from_chars(text.data(), text.data() + text.size(), read);
+    if (value > threshold ? read > threshold : value < threshold ? read < threshold : true) {
+      return text;
+    }
+  }
+  return fmt::format("{}", value);
+}
+
 /// A count of time steps computed from the user's values, for a refusal: "1.7e+13", or "more
 /// than 1.7e+308" when it overflowed (a time step of 1e-310 s gave "inf steps"; a double
 /// overflows from about 1.798e308).

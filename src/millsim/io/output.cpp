@@ -18,6 +18,7 @@
 #include <string_view>
 #include <utility>
 
+#include "millsim/core/error.hpp"
 #include "millsim/core/version.hpp"
 #include "millsim/io/partial_file.hpp"
 #include "millsim/measure/empirical_power.hpp"
@@ -450,8 +451,9 @@ std::vector<std::string> result_warnings(const MillResult& r) {
   if (!(r.energy_balance_error <= doubtful_energy_balance_error)) {
     // Three digits, without an exponent from 100 % on (2120 %, not 2.12e+03 %).
     const double error = 100.0 * r.energy_balance_error;
-    const std::string percent =
-        error >= 100.0 ? fmt::format("{:.0f}", error) : fmt::format("{:.3g}", error);
+    const std::string percent = error >= 100.0
+                                    ? fmt::format("{:.0f}", error)
+                                    : beyond_text(error, 100.0 * doubtful_energy_balance_error);
     warnings.push_back(fmt::format(
         "the energy balance is off by {} % of the shell's work (more than {:.0f} %): the "
         "time step may be too coarse for these contacts, and the results are doubtful",
@@ -482,10 +484,11 @@ std::vector<std::string> result_warnings(const MillResult& r) {
   }
   if (r.largest_overlap_fraction > doubtful_overlap_fraction) {
     warnings.push_back(fmt::format(
-        "contacts overlapped by up to {:.0f} % of the smaller ball's radius (more than {:.0f} %): "
+        "contacts overlapped by up to {} % of the smaller ball's radius (more than {:.0f} %): "
         "the springs are soft for these balls and this mill (materials.*.normal_stiffness), "
         "balls sink into each other{}, and the results are doubtful",
-        100.0 * r.largest_overlap_fraction, 100.0 * doubtful_overlap_fraction,
+        beyond_text(100.0 * r.largest_overlap_fraction, 100.0 * doubtful_overlap_fraction, 2),
+        100.0 * doubtful_overlap_fraction,
         r.largest_overlap_fraction >= 1.0 ? " and may pass through one another or a wall" : ""));
   }
   return warnings;

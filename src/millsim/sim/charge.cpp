@@ -76,9 +76,10 @@ std::optional<std::string> coarse_step_warning(const std::string& where, double 
                                 ? std::string("a quarter of the stability limit")
                                 : fmt::format("1/{:.0f} of it", steps_per_contact);
   return fmt::format(
-      "{}: simulation.time_step: {:.4g} s resolves the shortest contact ({:.3g} s) in {:.3g} "
+      "{}: simulation.time_step: {:.4g} s resolves the shortest contact ({:.3g} s) in {} "
       "steps, fewer than {:.0f}: the results may be inaccurate (\"auto\" takes {:.3g} s, {})",
-      where, time_step, shortest, shortest / time_step, fewest_steps_per_contact, automatic, share);
+      where, time_step, shortest, beyond_text(shortest / time_step, fewest_steps_per_contact),
+      fewest_steps_per_contact, automatic, share);
 }
 
 namespace {
