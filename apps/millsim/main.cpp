@@ -445,6 +445,7 @@ int validate_command(const std::string& directory, const JobOptions& options) {
     std::string name;
     double measured = 0.0, predicted = 0.0, tolerance = 0.0;
     std::optional<double> paper;
+    std::optional<std::string> failure;  // why the case did not finish, if it did not
   };
   std::vector<Row> rows(plans.size());
   // Every case's earlier results and the earlier table are moved aside before any case runs,
@@ -486,25 +487,50 @@ int validate_command(const std::string& directory, const JobOptions& options) {
     const bool progress = !options.quiet && share.at_a_time <= 1;
     // Each case's warnings name it: the cases may run together.
     const std::string context = fmt::format("case {}", config.source);
-    const MillResult result = config.dimension == 2
-                                  ? run_job<2>(plan, root_location, progress, started, context)
-                                  : run_job<3>(plan, root_location, progress, started, context);
-    rows[i] = {config.reference->case_name, config.reference->measured_kw, result.power_kw,
-               config.reference->tolerance, config.reference->paper_kw};
+    rows[i] = {config.reference->case_name, config.reference->measured_kw, 0.0,
+               config.reference->tolerance, config.reference->paper_kw,    std::nullopt};
+    // A case that fails while running (a full disk, a run that diverged) is reported in its
+    // row, as a sweep's point is, and the others' results still make the table.
+    try {
+      const MillResult result = config.dimension == 2
+                                    ? run_job<2>(plan, root_location, progress, started, context)
+                                    : run_job<3>(plan, root_location, progress, started, context);
+      rows[i].predicted = result.power_kw;
+    } catch (const std::bad_alloc&) {
+      rows[i].failure = "out of memory";
+    } catch (const std::exception& error) {
+      rows[i].failure = error.what();
+    }
+    if (rows[i].failure) {
+      const std::lock_guard lock(starting);
+      fmt::print(stderr, "millsim: {} failed: {}\n", context, *rows[i].failure);
+    }
   });
   fmt::print("{:<8} {:>12} {:>12} {:>12} {:>9} {:>10}  {}\n", "case", "measured_kW", "paper_kW",
              "millsim_kW", "error_%", "paper_err%", "within");
   int failures = 0;
+  int failed_runs = 0;
   std::string table = millsim::csv_line({"case", "measured_power_kw", "paper_power_kw", "power_kw",
                                          "error", "paper_error", "tolerance", "within"});
   for (const Row& r : rows) {
+    const std::string paper_error_value =
+        r.paper ? fmt::format("{}", (*r.paper - r.measured) / r.measured) : "";
+    if (r.failure) {
+      ++failed_runs;
+      table += millsim::csv_line({r.name, fmt::format("{}", r.measured),
+                                  r.paper ? fmt::format("{}", *r.paper) : "", "", "",
+                                  paper_error_value, fmt::format("{}", r.tolerance), "failed"});
+      fmt::print("{:<8} {:>12.4g} {:>12} {:>12} {:>9} {:>10}  failed (see above)\n", r.name,
+                 r.measured, r.paper ? fmt::format("{:.4g}", *r.paper) : std::string("n/a"), "", "",
+                 "");
+      continue;
+    }
     const double error = (r.predicted - r.measured) / r.measured;
     const bool ok = std::abs(error) <= r.tolerance;
     failures += ok ? 0 : 1;
     table += millsim::csv_line(
         {r.name, fmt::format("{}", r.measured), r.paper ? fmt::format("{}", *r.paper) : "",
-         fmt::format("{}", r.predicted), fmt::format("{}", error),
-         r.paper ? fmt::format("{}", (*r.paper - r.measured) / r.measured) : "",
+         fmt::format("{}", r.predicted), fmt::format("{}", error), paper_error_value,
          fmt::format("{}", r.tolerance), ok ? "yes" : "no"});
     // A case without the paper's figure shows n/a in its two columns.
     const std::string paper = r.paper ? fmt::format("{:.4g}", *r.paper) : std::string("n/a");
@@ -526,11 +552,13 @@ int validate_command(const std::string& directory, const JobOptions& options) {
   }
   millsim::write_whole_file(table_path, table);
   if (!options.quiet) fmt::print(stderr, "table in {}\n", table_path.string());
+  if (failed_runs > 0) {
+    fmt::print(stderr, "millsim: {} of {} cases failed to run\n", failed_runs, rows.size());
+  }
   if (failures > 0) {
     fmt::print(stderr, "millsim: {} of {} cases outside their tolerance\n", failures, rows.size());
-    return 1;
   }
-  return 0;
+  return failures > 0 || failed_runs > 0 ? 1 : 0;
 }
 
 /// Reads every point's config and plans it before running any, so that a bad key or value

@@ -1051,6 +1051,49 @@ TEST_F(Cli, AValidationStoppedHalfWayLeavesNothingOfTheOneBefore) {
   EXPECT_TRUE(fs::is_symlink(work_ / "real" / "c")) << "the link is kept";
 }
 
+TEST_F(Cli, AValidationCaseThatFailsWhileRunningIsARowOfTheTable) {
+  // A file-size limit (SIGXFSZ ignored, so that a write past it fails instead of ending the
+  // program) that case a's results fit under (its largest file, spectrum.csv, about 12.5 kB)
+  // and case b's do not (ten revolutions of power_timeseries.csv, about 57 kB). dash counts
+  // ulimit -f in 512-byte blocks, bash in 1024: 19.5 or 39 kB, between the two either way.
+  // Case b's failure once ended the validation with no table and case a's comparison lost.
+  fs::create_directories(work_ / "cases");
+  const auto revolutions = [](std::string text, int n) {
+    return with(with(std::move(text), "revolutions", "revolutions = " + std::to_string(n)),
+                "measure_revolutions", "measure_revolutions = 1");
+  };
+  std::ofstream(work_ / "cases" / "a.toml")
+      << revolutions(validation_case("case = \"a\"\nmeasured_power_kw = 0.5\n"), 1);
+  std::ofstream(work_ / "cases" / "b.toml") << revolutions(
+      validation_case("case = \"b\"\nmeasured_power_kw = 0.6\npaper_power_kw = 0.62\n"), 10);
+  const std::string command =
+      "cd " + quoted(work_.string()) + " && trap '' XFSZ && ulimit -f 39 && " +
+      quoted(MILLSIM_BINARY) +
+      " validate cases -q -j 1 -o runs --set simulation.settle_time=0.01 --set "
+      "output.snapshot_interval=0 >" +
+      quoted((root_ / "out").string()) + " 2>" + quoted((root_ / "err").string());
+  const int raw = std::system(command.c_str());
+  ASSERT_TRUE(raw != -1 && WIFEXITED(raw));
+  const std::string out = read_all(root_ / "out");
+  const std::string err = read_all(root_ / "err");
+  EXPECT_EQ(WEXITSTATUS(raw), 1) << err;
+  EXPECT_NE(
+      err.find("millsim: case cases/b.toml failed: runs/b/power_timeseries.csv: write failed: "),
+      std::string::npos)
+      << err;
+  EXPECT_NE(err.find("millsim: 1 of 2 cases failed to run\n"), std::string::npos) << err;
+  // Case a compared as ever; b's row says it failed.
+  EXPECT_NE(out.find("\na        "), std::string::npos) << out;
+  EXPECT_NE(out.find("\nb        "), std::string::npos) << out;
+  EXPECT_NE(out.find("failed (see above)"), std::string::npos) << out;
+  EXPECT_TRUE(fs::exists(work_ / "runs" / "a" / "summary.json"));
+  EXPECT_FALSE(fs::exists(work_ / "runs" / "b" / "summary.json"));
+  const std::string table = read_all(work_ / "runs" / "validation.csv");
+  EXPECT_NE(table.find("\nb,0.6,0.62,,,"), std::string::npos) << table;
+  EXPECT_NE(table.find(",0.15,failed\n"), std::string::npos) << table;
+  EXPECT_NE(table.find("\na,0.5,,0."), std::string::npos) << table;
+}
+
 TEST_F(Cli, ValidateReadsEveryCaseBeforeRunningAnyAndShowsAMissingPaperFigureAsNa) {
   fs::create_directories(work_ / "cases");
   std::ofstream(work_ / "cases" / "a.toml")
