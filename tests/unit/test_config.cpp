@@ -355,10 +355,29 @@ TEST(Config, RefusesLiftersThatOverlap) {
   EXPECT_EQ(parse_mill_config(with(base_config, "width", "width = 0.33"), file_name).lifter_width,
             0.33);
   // Two lifters cannot meet: the width is bounded by each one's share of the inner circle,
-  // π (0.45 − 0.04) = 1.288053 m.
-  const std::string two = with(with(base_config, "count", "count = 2"), "width", "width = 1.3");
-  expect_has(error_of(two), {at_line(two, "width"), "1.3 is not allowed", "< 1.28805",
-                             "the inner circle's share of each of 2 lifters"});
+  // π (0.45 − 0.3) = 0.4712389 m for lifters 0.3 m high.
+  const std::string two =
+      with(with(with(base_config, "count", "count = 2"), "height", "height = 0.3"), "width",
+           "width = 0.48");
+  expect_has(error_of(two), {at_line(two, "width"), "0.48 is not allowed", "< 0.471238",
+                             "the inner circle's share of each of 2 lifters 0.3 m high"});
+}
+
+TEST(Config, RefusesLiftersWiderThanTheShellsChord) {
+  // A bar wider than the shell's chord at its inner face stands with its inner corners outside
+  // the shell (and touches as a chord of it): 2 sqrt(0.45² − 0.41²) = 0.3709447 m for lifters
+  // 4 cm high, less than two lifters' share of the inner circle (1.288 m) or three's spacing
+  // (2 × 0.41 tan 60° = 1.42 m). (A review found 1.2 m accepted.)
+  for (const char* count : {"count = 2", "count = 3"}) {
+    const std::string text = with(with(base_config, "count", count), "width", "width = 0.371");
+    expect_has(error_of(text),
+               {at_line(text, "width"), "0.371 is not allowed", "< 0.3709447 ",
+                "the shell's chord at a lifter's inner face, 0.41 m from the axis"});
+    EXPECT_EQ(parse_mill_config(with(with(base_config, "count", count), "width", "width = 0.37"),
+                                file_name)
+                  .lifter_width,
+              0.37);
+  }
 }
 
 TEST(Config, RefusesBothSpeeds) {

@@ -164,13 +164,22 @@ void read_lifters(TableReader lifters, MillConfig& config) {
   // circle's share of each, 2π (R − h) / n, bounds the width.)
   const double inner_radius = radius - config.lifter_height;
   const int count = config.lifter_count;
-  const double widest =
+  const double spacing_bound =
       count >= 3 ? 2.0 * inner_radius * std::tan(pi / count) : 2.0 * pi * inner_radius / count;
+  // Nor wider than the shell's chord at the inner face: wider, the bar's inner corners and
+  // side faces would stand outside the shell, and it would touch as a chord of the shell.
+  const double chord = 2.0 * std::sqrt(radius * radius - inner_radius * inner_radius);
+  const double widest = std::min(spacing_bound, chord);
   const std::string why =
-      count >= 3 ? fmt::format("wider, the inner corners of {} lifters {} m high would meet", count,
-                               config.lifter_height)
-                 : fmt::format("the inner circle's share of each of {} lifters {} m high", count,
-                               config.lifter_height);
+      chord < spacing_bound
+          ? fmt::format(
+                "the shell's chord at a lifter's inner face, {:.6g} m from the axis; wider, "
+                "its inner corners would stand outside the shell",
+                inner_radius)
+      : count >= 3 ? fmt::format("wider, the inner corners of {} lifters {} m high would meet",
+                                 count, config.lifter_height)
+                   : fmt::format("the inner circle's share of each of {} lifters {} m high", count,
+                                 config.lifter_height);
   config.lifter_width = lifters.number(
       "width", std::nullopt,
       fmt::format("a number of metres > 0 and < {} ({})", limit_text(widest, Allowed::below), why),
