@@ -1014,8 +1014,20 @@ int run_program(int argc, char** argv) {
     }
     // The help of the command given, if any, lists what it takes.
     std::string help = "millsim --help";
-    for (const CLI::App* command : {run, info, validate, sweep}) {
-      if (command->parsed()) help = fmt::format("millsim {} --help", command->get_name());
+    for (CLI::App* command : {run, info, validate, sweep}) {
+      if (!command->parsed()) continue;
+      help = fmt::format("millsim {} --help", command->get_name());
+      // One of its options before it (millsim -q run): its help lists the option, so pointing
+      // there does not help; the option's place does.
+      const std::string first = argv[1];
+      const std::string name = first.substr(0, first.find('='));
+      if (name.size() > 1 && name[0] == '-' && command->get_option_no_throw(name) != nullptr) {
+        fmt::print(stderr,
+                   "millsim: error: command line: \"{}\" comes before the command; allowed: "
+                   "the command first, then its options (millsim {} {} ...)\n",
+                   first, command->get_name(), first);
+        return 2;
+      }
     }
     const std::string what = error.what();
     // A validator's message already says what is allowed.

@@ -865,6 +865,17 @@ TEST_F(Cli, MoreThreadsThanCoresAreWarnedOf) {
   EXPECT_EQ(one.err.find(" threads on "), std::string::npos) << one.err;
 }
 
+TEST_F(Cli, AnOptionBeforeTheCommandIsToldToFollowIt) {
+  // "millsim -q run" once said -q was not expected and to see millsim run --help, which lists it.
+  write_config(base_config);
+  const Outcome o = millsim("-q run mill.toml");
+  EXPECT_EQ(o.status, 2) << o.err;
+  EXPECT_EQ(o.err,
+            "millsim: error: command line: \"-q\" comes before the command; allowed: the command "
+            "first, then its options (millsim run -q ...)\n");
+  EXPECT_FALSE(fs::exists(work_ / "out"));
+}
+
 TEST_F(Cli, AnOptionTheCommandDoesNotTakePointsToThatCommandsHelp) {
   const Outcome o = millsim("sweep --bogus --vary mill.speed=0.5,0.6");
   EXPECT_EQ(o.status, 2) << o.err;

@@ -412,6 +412,10 @@ TEST(Config, RefusesMassFractionsThatDoNotSumToOne) {
                                 "sizes = [{ diameter = 0.05, mass_fraction = 0.6 },\n"
                                 "         { diameter = 0.04, mass_fraction = 0.4 }]");
   EXPECT_EQ(parse_mill_config(good, file_name).sizes.size(), 2u);
+  EXPECT_EQ(parse_mill_config(good, file_name).size_description, "2 sizes given");
+  const std::string one =
+      with(base_config, "ball_diameter", "sizes = [{ diameter = 0.05, mass_fraction = 1 }]");
+  EXPECT_EQ(parse_mill_config(one, file_name).size_description, "one size given");
 }
 
 TEST(Config, RefusesABadSizeListEntryAtItsLine) {

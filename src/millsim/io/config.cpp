@@ -343,7 +343,9 @@ void read_sizes(TableReader& section, MillConfig& config) {
                                            "fractions that sum to 1 (within 0.001)",
                                            total));
     }
-    config.size_description = fmt::format("{} sizes given", config.sizes.size());
+    config.size_description = config.sizes.size() == 1
+                                  ? std::string("one size given")
+                                  : fmt::format("{} sizes given", config.sizes.size());
   }
 }
 

@@ -318,10 +318,11 @@ SceneResult run_scene(const ScenePlan& plan, const std::filesystem::path& direct
 
 std::string scene_summary_line(const SceneResult& r) {
   return fmt::format(
-      "scene: {} particles, {} walls, {:.4g} s in {} steps of {:.4g} s; collisions ball-ball {}, "
-      "ball-wall {}; kinetic energy {:.4g} J -> {:.4g} J, dissipated {:.4g} J; {:.2f} s wall",
-      r.plan.config.particles.size(), r.plan.config.walls.size(), r.simulated_seconds, r.steps,
-      r.plan.time_step, r.ball_ball_collisions, r.ball_wall_collisions, r.kinetic_start,
+      "scene: {} particle{}, {} wall{}, {:.4g} s in {} steps of {:.4g} s; collisions ball-ball "
+      "{}, ball-wall {}; kinetic energy {:.4g} J -> {:.4g} J, dissipated {:.4g} J; {:.2f} s wall",
+      r.plan.config.particles.size(), r.plan.config.particles.size() == 1 ? "" : "s",
+      r.plan.config.walls.size(), r.plan.config.walls.size() == 1 ? "" : "s", r.simulated_seconds,
+      r.steps, r.plan.time_step, r.ball_ball_collisions, r.ball_wall_collisions, r.kinetic_start,
       r.kinetic_end, r.dissipated, r.wall_seconds);
 }
 
