@@ -1069,8 +1069,8 @@ TEST_F(Cli, AValidationCaseThatFailsWhileRunningIsARowOfTheTable) {
   // ulimit -f in 512-byte blocks, bash in 1024: 19.5 or 39 kB, between the two either way.
   // Case b's failure once ended the validation with no table and case a's comparison lost.
   fs::create_directories(work_ / "cases");
-  const auto revolutions = [](std::string text, int n) {
-    return with(with(std::move(text), "revolutions", "revolutions = " + std::to_string(n)),
+  const auto revolutions = [](const std::string& text, int n) {
+    return with(with(text, "revolutions", "revolutions = " + std::to_string(n)),
                 "measure_revolutions", "measure_revolutions = 1");
   };
   std::ofstream(work_ / "cases" / "a.toml")
