@@ -139,13 +139,10 @@ void warn(const std::vector<std::string>& warnings, std::string_view context = {
   }
 }
 
-/// The files a mill run writes in its output directory (besides snapshots/).
-constexpr std::initializer_list<const char*> mill_result_names = {
-    "summary.json", "power.csv",          "power_timeseries.csv",
-    "spectrum.csv", "charge_profile.csv", "impacts.csv"};
-/// What `run` clears, of a mill or a scene: the results of both kinds, so that a scene run
-/// where a mill ran (or the other way round) leaves none of the other's beside its own
-/// summary.json.
+/// What a run clears in its output directory (besides snapshots/), of a mill or a scene, run
+/// alone or as a sweep's point or a validation's case: the results of both kinds, so that a
+/// scene run where a mill ran (or the other way round) leaves none of the other's beside its
+/// own summary.json. Sweeps and validations check and clear the same names before any runs.
 constexpr std::initializer_list<const char*> run_result_names = {
     "summary.json",       "power.csv",   "power_timeseries.csv", "spectrum.csv",
     "charge_profile.csv", "impacts.csv", "trajectory.csv",       "final.csv"};
@@ -430,7 +427,7 @@ int validate_command(const std::string& directory, const JobOptions& options) {
     refuse_a_file_as_directory(config.output_directory, root_location);
     // What clearing the case's earlier results would refuse is refused before any case runs,
     // as a sweep refuses it for its points.
-    check_output_directory(config.output_directory, root_location, mill_result_names,
+    check_output_directory(config.output_directory, root_location, run_result_names,
                            config.snapshot_interval > 0.0 ? Snapshots::made : Snapshots::removed);
     MillPlan plan = millsim::plan_mill(config);
     // The charge placed as run places it (as info does), so that a filling the mill cannot
@@ -461,7 +458,7 @@ int validate_command(const std::string& directory, const JobOptions& options) {
         std::error_code error;  // (a link to a directory is one too)
         if (!std::filesystem::is_directory(std::filesystem::status(out, error))) continue;
         aside.push_back(
-            move_results_aside(out, root_location, mill_result_names, Snapshots::removed));
+            move_results_aside(out, root_location, run_result_names, Snapshots::removed));
       }
       std::error_code error;
       if (std::filesystem::is_directory(std::filesystem::status(root, error))) {
@@ -776,7 +773,7 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
   // point is checked again as it starts, when that would fail it after others had run).
   for (const MillPlan& plan : plans) {
     millsim_app::refuse_a_path_too_long(
-        plan.config.output_directory, root_location, mill_result_names,
+        plan.config.output_directory, root_location, run_result_names,
         plan.config.snapshot_interval > 0.0 ? Snapshots::made : Snapshots::removed);
   }
   std::vector<std::string> stale;
@@ -787,7 +784,7 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
     stale.push_back(name);
     check_output_directory(root / name,
                            fmt::format("{}, a point of the earlier sweep", root_location),
-                           mill_result_names, Snapshots::removed);
+                           run_result_names, Snapshots::removed);
   }
   std::vector<std::string> existing;  // this sweep's point directories that are there already
   for (const std::string& name : current) {
@@ -801,7 +798,7 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
     }
     if (!std::filesystem::is_directory(state)) continue;  // a file there fails that point only
     existing.push_back(name);
-    check_output_directory(root / name, root_location, mill_result_names, Snapshots::removed);
+    check_output_directory(root / name, root_location, run_result_names, Snapshots::removed);
   }
   check_output_directory(root, root_location, {"sweep.csv"});
   for (const char* name : {"sweep.csv", "sweep.csv.partial"}) {
@@ -829,11 +826,11 @@ int sweep_command(const JobOptions& options, const std::vector<std::string>& var
   try {
     for (const std::string& name : stale) {
       aside.push_back(
-          move_results_aside(root / name, earlier_context, mill_result_names, Snapshots::removed));
+          move_results_aside(root / name, earlier_context, run_result_names, Snapshots::removed));
     }
     for (const std::string& name : existing) {
       aside.push_back(
-          move_results_aside(root / name, root_location, mill_result_names, Snapshots::removed));
+          move_results_aside(root / name, root_location, run_result_names, Snapshots::removed));
     }
     aside.push_back(move_results_aside(root, root_location, {"sweep.csv.partial"}));
     // The table from the start, every point pending, so that a sweep stopped early still says

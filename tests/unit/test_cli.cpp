@@ -968,6 +968,17 @@ TEST_F(Cli, ValidateRefusesWhatWouldTakeTheNameOfItsTableBeforeAnyCaseRuns) {
       << partial.err;
   EXPECT_FALSE(fs::exists(work_ / "runs" / "a"));
   fs::remove_all(work_ / "runs");
+  // A directory of the user's under the name of a scene's result, which a case's run clears
+  // too: refused before any case runs, as for a mill's result (it was once refused by the
+  // case's run, after others had run, as a failed case).
+  fs::create_directories(work_ / "runs" / "a" / "trajectory.csv" / "kept");
+  const Outcome scene_name = millsim(std::string("validate cases -o runs ") + tiny_run);
+  EXPECT_EQ(scene_name.status, 2) << scene_name.err;
+  EXPECT_NE(scene_name.err.find("trajectory.csv"), std::string::npos) << scene_name.err;
+  EXPECT_EQ(scene_name.err.find("running"), std::string::npos) << scene_name.err;
+  EXPECT_TRUE(fs::exists(work_ / "runs" / "a" / "trajectory.csv" / "kept"));
+  EXPECT_FALSE(fs::exists(work_ / "runs" / "validation.csv"));
+  fs::remove_all(work_ / "runs");
   // A case whose results would go to OUT/validation.csv/.
   fs::copy_file(work_ / "cases" / "a.toml", work_ / "cases" / "validation.csv.toml");
   const Outcome named = millsim(std::string("validate cases -o runs ") + tiny_run);
