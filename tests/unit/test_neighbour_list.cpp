@@ -168,10 +168,12 @@ TEST(NeighbourList, ParticlesFarApartOrDivergedSizeTheGridWithinBounds) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   const std::vector<double> radius(4, 5e-5);
-  for (const double odd : {far, -far, nan, inf, -inf}) {
+  const double huge = std::numeric_limits<double>::max();  // an infinite span from -huge
+  for (const double odd : {far, -far, nan, inf, -inf, huge}) {
     SCOPED_TRACE(odd);
     NeighbourList<2> discs(5e-6);
-    discs.rebuild({Vec2{{odd, odd}}, Vec2{{0.0, 0.0}}, Vec2{{0.0, 9e-5}}, Vec2{{far, 0.0}}},
+    discs.rebuild({Vec2{{odd, odd}}, Vec2{{0.0, 0.0}}, Vec2{{0.0, 9e-5}},
+                   Vec2{{odd == huge ? -huge : far, 0.0}}},
                   radius);
     EXPECT_EQ(listed_pairs(discs), (PairList{{1, 2}}));
     NeighbourList<3> spheres(5e-6);

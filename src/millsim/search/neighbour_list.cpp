@@ -247,6 +247,12 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
     // allows ±1e6 m) ask for more cells than an integer holds, and a product that wrapped
     // round to a small number once passed the test and sized the grid wrongly.
     const double most_cells = 32.0 * static_cast<double>(count) + 4096.0;
+    // (Finite bounds can still be an infinite span apart, ±1e308: taken as the largest double,
+    // so that doubling the cells ends.)
+    std::array<double, D> span{};
+    for (int a = 0; a < D; ++a) {
+      span[a] = std::min(high[a] - low[a], std::numeric_limits<double>::max());
+    }
     double cell = 2.0 * *smallest + skin_;
     std::array<double, D> cells_wide{};
     for (;;) {
@@ -254,7 +260,7 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
       for (int a = 0; a < D; ++a) {
         // Along a periodic axis the cells tile the period exactly, each at least `cell`.
         cells_wide[a] = a == D - 1 && periodic ? std::max(1.0, std::floor(period_ / cell))
-                                               : std::floor((high[a] - low[a]) / cell) + 1.0;
+                                               : std::floor(span[a] / cell) + 1.0;
         product *= cells_wide[a];
       }
       if (product <= most_cells) break;
