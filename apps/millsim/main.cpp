@@ -139,6 +139,24 @@ void warn(const std::vector<std::string>& warnings, std::string_view context = {
   }
 }
 
+/// Warns, once, when more threads are asked for than there are cores: the threads that share
+/// a step wait for each other at its end, and some are always waiting for a core (a 1215-ball
+/// 3D mill: 2.5 s on one thread, 64 s on 64, on two cores). Called as a job starts to run, so
+/// that a refused config says only why.
+void warn_of_more_threads_than_cores() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    const int threads = omp_get_max_threads();
+    const int cores = omp_get_num_procs();
+    if (threads <= cores) return;
+    warn(
+        {fmt::format("{} threads on {} core{}: the threads that share a step wait for each "
+                     "other at its end, so it can run many times slower than with -j {} (the "
+                     "results are the same)",
+                     threads, cores, cores == 1 ? "" : "s", cores)});
+  });
+}
+
 /// What a run clears in its output directory (besides snapshots/), of a mill or a scene, run
 /// alone or as a sweep's point or a validation's case: the results of both kinds, so that a
 /// scene run where a mill ran (or the other way round) leaves none of the other's beside its
@@ -187,6 +205,7 @@ int run_scene_command(const millsim::SceneConfig& scene, const JobOptions& optio
   const std::vector<std::string> cleared = prepare_output_directory(
       out, output_location(scene, options), run_result_names, Snapshots::removed);
   if (!options.quiet) fmt::print("millsim: running scene {}\n", scene.source);
+  warn_of_more_threads_than_cores();
   warn(cleared);
   warn(plan.warnings);
   ProgressLine progress(!options.quiet);
@@ -211,6 +230,7 @@ int run_command(const JobOptions& options) {
   const MillConfig& config = std::get<MillConfig>(job);
   const MillResult result = run_job(config, output_location(config, options), !options.quiet, [&] {
     if (!options.quiet) fmt::print("millsim: running {}\n", config.source);
+    warn_of_more_threads_than_cores();
   });
   fmt::print("{}\n", millsim::summary_line(result));
   if (!options.quiet) {
@@ -474,6 +494,7 @@ int validate_command(const std::string& directory, const JobOptions& options) {
   // The cases as a sweep's points: as many at a time as there are threads (the small mills
   // gain little from a second thread), a progress line only when they run one at a time.
   const millsim::ThreadShare share = millsim::share_threads(omp_get_max_threads(), plans.size());
+  warn_of_more_threads_than_cores();
   millsim::run_shared(plans.size(), share, [&](std::size_t i) {
     const MillPlan& plan = plans[i];
     const MillConfig& config = plan.config;
@@ -645,6 +666,7 @@ void run_sweep(const std::vector<MillPlan>& plans, const std::vector<millsim::Sw
       }
     }
   };
+  warn_of_more_threads_than_cores();
   millsim::run_shared(rows.size(), share,
                       [&](std::size_t i) { run_point(i, !quiet && share.at_a_time <= 1); });
 }
@@ -1043,20 +1065,6 @@ int run_program(int argc, char** argv) {
     }
   }
   if (options.threads > 0) omp_set_num_threads(options.threads);
-  if (run->parsed() || validate->parsed() || sweep->parsed()) {
-    // More threads than cores: the threads that share a step wait for each other at its end,
-    // and some are always waiting for a core (a 1215-ball 3D mill: 2.5 s on one thread, 64 s
-    // on 64, on two cores).
-    const int threads = omp_get_max_threads();
-    const int cores = omp_get_num_procs();
-    if (threads > cores) {
-      warn(
-          {fmt::format("{} threads on {} core{}: the threads that share a step wait for each "
-                       "other at its end, so it can run many times slower than with -j {} "
-                       "(the results are the same)",
-                       threads, cores, cores == 1 ? "" : "s", cores)});
-    }
-  }
   // An empty path is a mistake (an unset shell variable), not a request for the default.
   const auto given_empty = [](std::initializer_list<const CLI::App*> commands, const char* option,
                               const std::string& value) {

@@ -863,6 +863,10 @@ TEST_F(Cli, MoreThreadsThanCoresAreWarnedOf) {
   const Outcome one = millsim(std::string("run mill.toml -q -o one -j 1 ") + tiny_run);
   EXPECT_EQ(one.status, 0) << one.err;
   EXPECT_EQ(one.err.find(" threads on "), std::string::npos) << one.err;
+  // A refused config says only why (the warning comes as a job starts to run).
+  const Outcome refused = millsim("run mill.toml -q -o refused -j 1024 --set mill.speed=7");
+  EXPECT_EQ(refused.status, 2) << refused.err;
+  EXPECT_EQ(refused.err.find(" threads on "), std::string::npos) << refused.err;
 }
 
 TEST_F(Cli, AnOptionBeforeTheCommandIsToldToFollowIt) {
@@ -1166,7 +1170,10 @@ TEST_F(Cli, ValidateReadsEveryCaseBeforeRunningAnyAndShowsAMissingPaperFigureAsN
   EXPECT_TRUE(good.err.ends_with(count_line)) << good.err;
   std::istringstream err_lines(good.err.substr(0, good.err.size() - count_line.size()));
   for (std::string line; std::getline(err_lines, line);) {
-    EXPECT_TRUE(line.starts_with("millsim: warning: results in runs/")) << line;
+    // (and, where OMP_NUM_THREADS asks for more threads than the cores, that warning)
+    EXPECT_TRUE(line.starts_with("millsim: warning: results in runs/") ||
+                line.find(" threads on ") != std::string::npos)
+        << line;
   }
   EXPECT_TRUE(fs::exists(work_ / "runs" / "a" / "summary.json"));
   EXPECT_TRUE(fs::exists(work_ / "runs" / "b" / "summary.json"));
