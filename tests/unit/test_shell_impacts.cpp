@@ -39,6 +39,12 @@ TEST(ShellImpacts, CountsAndEnergiesPerWallTypeAndNothingElse) {
   EXPECT_EQ(impacts.total_count(ContactType::ball_shell), 2);
   EXPECT_EQ(impacts.total_count(ContactType::ball_lifter), 1);
   EXPECT_EQ(impacts.total_count(ContactType::ball_end_plate), 1);
+  // Asked of a type that is not a wall's: none (it once read past the end of the counts).
+  for (const ContactType other : {ContactType::ball_ball, ContactType::ball_plane}) {
+    EXPECT_EQ(impacts.total_count(other), 0);
+    EXPECT_EQ(impacts.count(other, 46), 0);
+    EXPECT_EQ(impacts.energy(other, 46), 0.0);
+  }
 }
 
 }  // namespace

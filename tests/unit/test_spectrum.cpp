@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <stdexcept>
 #include <string_view>
 #include <vector>
 
@@ -135,6 +136,24 @@ TEST(ImpactSpectrum, OutOfRangeEnergiesLandInTheEndBinsWithTheirOwnEnergy) {
   // The energy kept is the energy recorded, not the bin's edge.
   EXPECT_DOUBLE_EQ(s.energy(ContactType::ball_shell, 0), 0.0 + 1e-30 + 1e-12 + 0.99e-10);
   EXPECT_DOUBLE_EQ(s.energy(ContactType::ball_shell, 69), 1e4 + 1e5 + 1e9);
+}
+
+TEST(ImpactSpectrum, AnEnergyThatIsNotANumberOrInfiniteStillLandsInAnEndBin) {
+  // Only a diverged run could record one; its bin was an integer cast of a NaN or an infinity
+  // (undefined). The energy is kept as recorded, so the bin shows what happened.
+  ImpactSpectrum s;
+  s.record(ContactType::ball_ball, std::nan(""));
+  s.record(ContactType::ball_ball, HUGE_VAL);
+  EXPECT_EQ(s.count(ContactType::ball_ball, 0), 1);
+  EXPECT_TRUE(std::isnan(s.energy(ContactType::ball_ball, 0)));
+  EXPECT_EQ(s.count(ContactType::ball_ball, 69), 1);
+  EXPECT_EQ(s.energy(ContactType::ball_ball, 69), HUGE_VAL);
+}
+
+TEST(ImpactSpectrum, RefusesAGridWithoutBins) {
+  EXPECT_THROW(ImpactSpectrum(1e-10, 0, 14), std::invalid_argument);
+  EXPECT_THROW(ImpactSpectrum(1e-10, 5, 0), std::invalid_argument);
+  EXPECT_THROW(ImpactSpectrum(0.0, 5, 14), std::invalid_argument);
 }
 
 TEST(ImpactSpectrum, TotalsAreKeptPerContactType) {

@@ -24,9 +24,21 @@ void ShellImpacts::record(ContactType type, double lab_angle, double energy) {
   energies_[k][static_cast<std::size_t>(bin)] += energy;
 }
 
+long ShellImpacts::count(ContactType type, int bin) const {
+  const std::size_t k = index(type);
+  return k == types.size() ? 0 : counts_[k][static_cast<std::size_t>(bin)];
+}
+
+double ShellImpacts::energy(ContactType type, int bin) const {
+  const std::size_t k = index(type);
+  return k == types.size() ? 0.0 : energies_[k][static_cast<std::size_t>(bin)];
+}
+
 long ShellImpacts::total_count(ContactType type) const {
+  const std::size_t k = index(type);
+  if (k == types.size()) return 0;  // not a wall type: none recorded
   long total = 0;
-  for (const long n : counts_[index(type)]) total += n;
+  for (const long n : counts_[k]) total += n;
   return total;
 }
 

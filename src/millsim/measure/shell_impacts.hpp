@@ -32,12 +32,10 @@ class ShellImpacts {
 
   /// The bin of a lab angle.
   int bin_of(double lab_angle) const;
-  long count(ContactType type, int bin) const {
-    return counts_[index(type)][static_cast<std::size_t>(bin)];
-  }
-  double energy(ContactType type, int bin) const {
-    return energies_[index(type)][static_cast<std::size_t>(bin)];
-  }
+  /// The count and the energy of `type`'s collisions in a bin, and its count in all; none for
+  /// a type that is not a wall's (ball–ball, ball–plane).
+  long count(ContactType type, int bin) const;
+  double energy(ContactType type, int bin) const;
   long total_count(ContactType type) const;
 
  private:

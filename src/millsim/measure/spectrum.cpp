@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
 
 namespace millsim {
 
@@ -24,6 +25,10 @@ std::string_view contact_type_name(ContactType type) {
 
 ImpactSpectrum::ImpactSpectrum(double lowest_energy, int bins_per_decade, int decades)
     : lowest_energy_(lowest_energy), bins_per_decade_(bins_per_decade) {
+  if (!(lowest_energy > 0.0) || bins_per_decade <= 0 || decades <= 0) {
+    throw std::invalid_argument(
+        "ImpactSpectrum: the lowest energy, the bins a decade and the decades must be > 0");
+  }
   const std::size_t bins =
       static_cast<std::size_t>(bins_per_decade) * static_cast<std::size_t>(decades);
   for (auto& c : counts_) c.assign(bins, 0);
@@ -31,9 +36,14 @@ ImpactSpectrum::ImpactSpectrum(double lowest_energy, int bins_per_decade, int de
 }
 
 void ImpactSpectrum::record(ContactType type, double energy) {
-  const double position = std::log10(std::max(energy, lowest_energy_) / lowest_energy_);
+  // (A NaN energy, which only a diverged run could give, goes to the first bin, an infinite
+  // one to the last: the bin is found in doubles before it becomes an integer.)
+  const double position =
+      std::log10((energy > lowest_energy_ ? energy : lowest_energy_) / lowest_energy_);
   const auto last = static_cast<long>(bin_count()) - 1;
-  long bin = std::clamp(static_cast<long>(position * bins_per_decade_), 0L, last);
+  long bin = std::clamp(
+      static_cast<long>(std::min(position * bins_per_decade_, static_cast<double>(last))), 0L,
+      last);
   // The logarithm can round an energy sitting exactly on an edge to either side: settle it
   // against the edges as reported, so that a bin holds [lower edge, upper edge).
   if (bin < last && energy >= bin_lower_edge(static_cast<std::size_t>(bin + 1))) ++bin;
