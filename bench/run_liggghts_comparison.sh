@@ -31,7 +31,10 @@
 #
 # Environment: MILLSIM_BUILD (a build directory to use as it is; default build/release, built
 # with the release preset), MILLSIM_SOURCE (the source tree of that build, default this one),
-# LIGGGHTS_WORK (work directory, default runs/liggghts-comparison), SETTLE_TIME (s, default 0.4).
+# LIGGGHTS_WORK (work directory, default runs/liggghts-comparison), SETTLE_TIME (s, default 0.4),
+# MILL_CONFIG (the mill, default bench/mill-3d-20k.toml; both codes read it, so a copy with
+# another simulation.time_step compares them at that step; it must give a step in seconds, not
+# "auto"). Needs python3 (for make_input.py; installed with apt-get if missing).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -78,7 +81,7 @@ else
 fi
 warmup=1000
 settle=${SETTLE_TIME:-0.4}
-config=bench/mill-3d-20k.toml
+config=${MILL_CONFIG:-bench/mill-3d-20k.toml}
 work=${LIGGGHTS_WORK:-runs/liggghts-comparison}
 build=${MILLSIM_BUILD:-build/release}
 
@@ -92,6 +95,12 @@ if ! command -v liggghts >/dev/null; then
     || { apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends liggghts; }
 fi
 echo "== $(dpkg-query -W -f '${Package} ${Version}' liggghts 2>/dev/null || echo liggghts)"
+# make_input.py needs Python 3.11 (tomllib), Debian 12's python3, which liggghts does not pull in.
+if ! command -v python3 >/dev/null; then
+  if [ "$(id -u)" != 0 ]; then echo "python3 is missing; run as root to install it" >&2; exit 1; fi
+  DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends python3 \
+    || { apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends python3; }
+fi
 
 # --- millsim -----------------------------------------------------------------------------------
 if [ -z "${MILLSIM_BUILD:-}" ]; then
@@ -139,7 +148,7 @@ if [ "$mode" = speed ]; then
         | tee "$work/millsim-$n-$round.txt" | grep -E '^(timed|particle-steps)'
       ms[$n,$round]=$(rate_of_millsim "$work/millsim-$n-$round.txt")
       echo "== round $round of $rounds: LIGGGHTS, $n MPI rank(s): $warmup warmup + $steps timed steps"
-      (cd "$work/timing" && mpirun --allow-run-as-root --bind-to none -np $n liggghts \
+      (cd "$work/timing" && mpirun --allow-run-as-root --oversubscribe --bind-to none -np $n liggghts \
         -in in.mill -log "log.np$n.$round" > "screen.np$n.$round")
       grep '^Loop time of' "$work/timing/log.np$n.$round" | tail -1
       lg[$n,$round]=$(rate_of_liggghts "$work/timing/log.np$n.$round")
@@ -180,7 +189,7 @@ echo "== power: $lift steps at full speed from the settled state, then $window s
 millsim_pid=$!
 python3 bench/liggghts/make_input.py "$config" "$state" "$work/power" --mode power \
   --lift "$lift" --window "$window"
-(cd "$work/power" && mpirun --allow-run-as-root --bind-to none -np 1 liggghts \
+(cd "$work/power" && mpirun --allow-run-as-root --oversubscribe --bind-to none -np 1 liggghts \
   -in in.mill -log log.power > screen.power)
 wait "$millsim_pid"
 cat "$work/millsim-power.txt"
