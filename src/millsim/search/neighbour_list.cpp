@@ -217,8 +217,14 @@ void NeighbourList<D>::rebuild(const std::vector<Vec<D>>& position,
     }
 #pragma omp parallel if (parallel)
     {
-      Vec<D> own_low = low;
-      Vec<D> own_high = high;
+      // (From the constants, not from `low` and `high`, which a thread done with its share
+      // may be writing already.)
+      Vec<D> own_low;
+      Vec<D> own_high;
+      for (int a = 0; a < D; ++a) {
+        own_low[a] = none_low;
+        own_high[a] = none_high;
+      }
 #pragma omp for schedule(static) nowait
       for (std::size_t i = 0; i < count; ++i) {
         for (int a = 0; a < D; ++a) {
