@@ -11,6 +11,7 @@
 #include <csignal>
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -364,15 +365,35 @@ TEST(VtkOutput, TheCollectionIsWholeAfterEverySnapshot) {
   std::filesystem::remove_all(directory);
 }
 
+/// What `write` throws (its message; empty if nothing) while the process may write no file
+/// beyond `limit` bytes. SIGXFSZ is ignored meanwhile, so that a write past the limit fails
+/// with EFBIG instead of ending the process.
+std::string message_under_file_size_limit(rlim_t limit, const std::function<void()>& write) {
+  rlimit saved{};
+  if (getrlimit(RLIMIT_FSIZE, &saved) != 0) return "getrlimit failed";
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit small = saved;
+  small.rlim_cur = limit;
+  std::string message;
+  if (setrlimit(RLIMIT_FSIZE, &small) != 0) {
+    message = "setrlimit failed";
+  } else {
+    try {
+      write();
+    } catch (const std::runtime_error& e) {
+      message = e.what();
+    }
+    setrlimit(RLIMIT_FSIZE, &saved);
+  }
+  std::signal(SIGXFSZ, old_handler);
+  return message;
+}
+
 TEST(VtkOutput, ACollectionWhoseWriteFailsIsLeftWholeWithWhatItListed) {
-  // A file-size limit the collection's third entry passes (SIGXFSZ ignored, so that the write
-  // fails with EFBIG instead of ending the process).
+  // A file-size limit the collection's third entry passes.
   const std::filesystem::path directory = testing::fresh_directory("vtk");
   const std::filesystem::path path = directory / "particles.pvd";
   const std::string entry = "snapshot_000000.vtp";
-  rlimit saved{};
-  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved), 0);
-  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
   std::string whole_after_two;
   std::string message;
   {
@@ -380,17 +401,9 @@ TEST(VtkOutput, ACollectionWhoseWriteFailsIsLeftWholeWithWhatItListed) {
     collection.add(0.0, {entry});
     collection.add(0.05, {entry});
     whole_after_two = read_all(path);
-    rlimit small = saved;
-    small.rlim_cur = whole_after_two.size() + 10;
-    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
-    try {
-      collection.add(0.1, {entry});
-    } catch (const std::runtime_error& e) {
-      message = e.what();
-    }
-    setrlimit(RLIMIT_FSIZE, &saved);
+    message = message_under_file_size_limit(whole_after_two.size() + 10,
+                                            [&] { collection.add(0.1, {entry}); });
   }
-  std::signal(SIGXFSZ, old_handler);
   EXPECT_EQ(message, path.string() + ": write failed: " +
                          std::make_error_code(std::errc::file_too_large).message());
   EXPECT_EQ(read_all(path), whole_after_two);
@@ -407,9 +420,6 @@ TEST(VtkOutput, ASnapshotIndexWhoseWriteFailsKeepsWholeRowsOnly) {
   settings.time_step = 1e-3;
   World<2> world(settings, Walls<2>{});
   world.particles().add(Vec2{}, 0.01, 0.002);
-  rlimit saved{};
-  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved), 0);
-  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
   std::string whole_after_two;
   std::string message;
   {
@@ -418,18 +428,10 @@ TEST(VtkOutput, ASnapshotIndexWhoseWriteFailsKeepsWholeRowsOnly) {
     world.step();
     snapshots.write(world);
     whole_after_two = read_all(index);
-    rlimit small = saved;
-    small.rlim_cur = whole_after_two.size() + 10;
-    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
     world.step();
-    try {
-      snapshots.write(world);
-    } catch (const std::runtime_error& e) {
-      message = e.what();
-    }
-    setrlimit(RLIMIT_FSIZE, &saved);
+    message =
+        message_under_file_size_limit(whole_after_two.size() + 10, [&] { snapshots.write(world); });
   }
-  std::signal(SIGXFSZ, old_handler);
   EXPECT_EQ(message, index.string() + ": write failed: " +
                          std::make_error_code(std::errc::file_too_large).message());
   EXPECT_TRUE(std::filesystem::exists(directory / "snapshot_000002.csv"))
@@ -441,20 +443,8 @@ TEST(VtkOutput, ASnapshotIndexWhoseWriteFailsKeepsWholeRowsOnly) {
 
 TEST(VtkOutput, AFileWhoseWriteFailsSaysWhy) {
   const std::filesystem::path directory = testing::fresh_directory("vtk");
-  rlimit saved{};
-  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved), 0);
-  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
-  rlimit small = saved;
-  small.rlim_cur = 1000;
-  std::string message;
-  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
-  try {
-    write_whole_file(directory / "snapshot_000000.vtp", std::string(5000, 'x'));
-  } catch (const std::runtime_error& e) {
-    message = e.what();
-  }
-  setrlimit(RLIMIT_FSIZE, &saved);
-  std::signal(SIGXFSZ, old_handler);
+  const std::string message = message_under_file_size_limit(
+      1000, [&] { write_whole_file(directory / "snapshot_000000.vtp", std::string(5000, 'x')); });
   EXPECT_EQ(message, (directory / "snapshot_000000.vtp").string() + ": write failed: " +
                          std::make_error_code(std::errc::file_too_large).message());
   EXPECT_FALSE(std::filesystem::exists(directory / "snapshot_000000.vtp.partial"));

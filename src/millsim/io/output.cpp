@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -313,18 +312,7 @@ void SnapshotWriter::write(const World<D>& world) {
   }
   // Failed (a full disk, say): the index as it was, whole rows only (the file removed if it
   // had none), as the collections are left.
-  const int error = errno;
-  std::clearerr(index_);
-  if (first) {
-    std::fclose(index_);
-    index_ = nullptr;
-    std::error_code ignored;
-    std::filesystem::remove(index_path, ignored);
-  } else if (::ftruncate(::fileno(index_), index_end_) == 0) {
-    std::fseek(index_, index_end_, SEEK_SET);
-  }
-  throw std::runtime_error(fmt::format("{}: write failed: {}", index_path.string(),
-                                       error != 0 ? std::strerror(error) : "unknown error"));
+  undo_failed_append(index_, index_path, index_end_, first, errno);
 }
 
 template void SnapshotWriter::write(const World<2>&);

@@ -1,5 +1,7 @@
 #include "millsim/io/partial_file.hpp"
 
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -57,6 +59,23 @@ void write_whole_file(const std::filesystem::path& path, std::string_view text) 
   PartialFile file(path);
   file.write(text);
   file.commit();
+}
+
+void undo_failed_append(std::FILE*& file, const std::filesystem::path& path, long whole, bool first,
+                        int error, std::string_view tail) {
+  std::clearerr(file);
+  if (first) {
+    std::fclose(file);
+    file = nullptr;
+    std::error_code ignored;
+    std::filesystem::remove(path, ignored);
+  } else if (::ftruncate(::fileno(file), whole) == 0 && std::fseek(file, whole, SEEK_SET) == 0 &&
+             !tail.empty()) {
+    std::fwrite(tail.data(), 1, tail.size(), file);
+    std::fflush(file);
+  }
+  throw std::runtime_error(fmt::format("{}: write failed: {}", path.string(),
+                                       error != 0 ? std::strerror(error) : "unknown error"));
 }
 
 }  // namespace millsim

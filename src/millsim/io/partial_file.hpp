@@ -43,4 +43,12 @@ class PartialFile {
 /// Writes `text` to `path` through a PartialFile.
 void write_whole_file(const std::filesystem::path& path, std::string_view text);
 
+/// For a file that grows as a run goes (snapshots/index.csv, a .pvd collection), after an
+/// append to it failed with errno `error` (a full disk, say): puts it back as it was, its first
+/// `whole` bytes and then `tail` (what it keeps after its entries), or, if the append was its
+/// first write, removes it (closing `file` and setting it to null); then throws
+/// std::runtime_error "PATH: write failed: REASON".
+[[noreturn]] void undo_failed_append(std::FILE*& file, const std::filesystem::path& path,
+                                     long whole, bool first, int error, std::string_view tail = {});
+
 }  // namespace millsim

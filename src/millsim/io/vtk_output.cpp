@@ -1,7 +1,6 @@
 #include "millsim/io/vtk_output.hpp"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -16,6 +15,7 @@
 #include <utility>
 
 #include "millsim/core/constants.hpp"
+#include "millsim/io/partial_file.hpp"
 
 namespace millsim {
 namespace {
@@ -350,20 +350,7 @@ void PvdCollection::add(double time, const std::vector<std::string>& files) {
   }
   // Failed (a full disk, say): the collection as it was, whole, with what it listed (the
   // first add's file removed: it listed nothing).
-  const int error = errno;
-  std::clearerr(file_);
-  if (first) {
-    std::fclose(file_);
-    file_ = nullptr;
-    std::error_code ignored;
-    std::filesystem::remove(path_, ignored);
-  } else if (::ftruncate(::fileno(file_), entries_end_) == 0 &&
-             std::fseek(file_, entries_end_, SEEK_SET) == 0) {
-    std::fwrite(collection_tail.data(), 1, collection_tail.size(), file_);
-    std::fflush(file_);
-  }
-  throw std::runtime_error(fmt::format("{}: write failed: {}", path_.string(),
-                                       error != 0 ? std::strerror(error) : "unknown error"));
+  undo_failed_append(file_, path_, entries_end_, first, errno, collection_tail);
 }
 
 }  // namespace millsim
